@@ -1,0 +1,87 @@
+// Cape: one simulated cape — a shared Fabric, its own settings and state, and the solver's scratch memory,
+// sized once so that stepping never allocates.
+#pragma once
+
+#include "cape/core/CapeSettings.h"
+#include "cape/core/CapeState.h"
+#include "cape/core/Collider.h"
+#include "cape/core/Fabric.h"
+
+#include <memory>
+#include <vector>
+
+namespace cape {
+
+/// A view of the colliders for one step (the caller owns them; see Collider::moveTo).
+struct ColliderSpan {
+  const Collider* data = nullptr;
+  std::size_t size = 0;
+  ColliderSpan() = default;
+  ColliderSpan(const Collider* d, std::size_t n) : data(d), size(n) {}
+  ColliderSpan(const std::vector<Collider>& v) : data(v.data()), size(v.size()) {}  // NOLINT: implicit by design
+  const Collider* begin() const { return data; }
+  const Collider* end() const { return data + size; }
+};
+
+class Cape {
+ public:
+  /// Makes a cape at the fabric's rest shape placed by `placement` (world = placement * rest), at rest.
+  /// Check `status()`: on bad settings or fabric the cape is empty and step() does nothing.
+  Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement = Pose());
+
+  const Status& status() const { return status_; }
+  bool ok() const { return status_.ok(); }
+
+  const Fabric& fabric() const { return *fabric_; }
+  const FabricPtr& fabricPtr() const { return fabric_; }
+  const CapeSettings& settings() const { return settings_; }
+  /// Changes the settings; rejected (returning the error, keeping the old settings) if invalid.
+  Status setSettings(const CapeSettings& settings);
+  const CapeState& state() const { return state_; }
+  /// Direct access for tools and tests; keep inverse masses and pins consistent (use pin()/unpin()).
+  CapeState& mutableState() { return state_; }
+
+  /// Pins a particle to a world target (its inverse mass becomes 0). Returns the pin's index.
+  /// The particle jumps to the target at the next step. Pinning a pinned particle retargets it.
+  std::size_t pin(std::uint32_t particle, const Vec3& target);
+  /// Releases a particle (its inverse mass is restored from the fabric's mass).
+  void unpin(std::uint32_t particle);
+  /// The pin has moved: its target at the end of the next step is `target`; the last target becomes the
+  /// start of the sweep.
+  void movePin(std::size_t pinIndex, const Vec3& target);
+  /// Moves every particle and target rigidly by `delta` (pose applied to world positions) and rotates
+  /// velocities with it: what a teleport of the character does to its cape, without stretching it.
+  void teleport(const Pose& delta);
+
+  /// Advances the cape by dt seconds (settings().substeps substeps) against the colliders, which are swept
+  /// from their previous to their current pose. Non-finite or non-positive dt is ignored.
+  void step(float dt, ColliderSpan colliders);
+
+  /// Sum over particles of kinetic and gravitational potential energy plus spring (Hooke) energy, J.
+  double energy() const;
+
+ private:
+  void stepXpbd(float h, float s0, float s1, ColliderSpan colliders);
+  void stepExplicit(float h, float s0, float s1, ColliderSpan colliders);
+  void movePinsTo(float s, float h);
+  void collide(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode);
+  void solveSprings(float h);
+  void solveTethers();
+  void accumulateExternalAcceleration(float t);
+
+  FabricPtr fabric_;
+  CapeSettings settings_;
+  CapeState state_;
+  Status status_ = Status::success();
+
+  // Scratch, sized once in the constructor.
+  Points startPositions_;        ///< Positions at the start of the substep.
+  Points acceleration_;          ///< External acceleration per particle (gravity + wind), m/s^2.
+  Eigen::VectorXf freeMask_;     ///< 1 for free particles, 0 for pinned, refreshed each step.
+  Eigen::VectorXf lambda_;       ///< XPBD Lagrange multipliers of every spring, per substep.
+  std::vector<float> familyCompliance_;
+  std::vector<Pose> colliderStart_;  ///< Scratch: collider poses at the substep's ends.
+  std::vector<Pose> colliderEnd_;
+};
+
+}  // namespace cape

@@ -1,0 +1,71 @@
+// CapeSettings: per-cape parameters, plain data with units. Checked by validate() before every run.
+#pragma once
+
+#include "cape/core/Types.h"
+
+namespace cape {
+
+/// How the cape's equations of motion are integrated.
+enum class Integrator : int {
+  /// Extended position-based dynamics (Macklin, Müller and Chentanez 2016, "XPBD"), with small substeps
+  /// (Macklin et al. 2019, "Small Steps in Physics Simulation") and long-range attachments. The default:
+  /// stiff cloth stays stable at a 1/60 s frame with 4 substeps; see the README for why it was chosen.
+  Xpbd = 0,
+  /// The seed's explicit Hooke mass-spring with symplectic Euler. A reference: only stable for soft springs
+  /// and short steps (the seed used 0.00875 s, four per 0.035 s frame); validate() rejects set-ups beyond its
+  /// stability bound.
+  ExplicitSpring = 1,
+};
+const char* toString(Integrator integrator);
+
+/// Wind acting on the cape (the aerodynamic model lives with the solver; this is its data).
+struct WindSettings {
+  enum class Model : int { None = 0, SineWave = 1, Aerodynamic = 2 };
+  Model model = Model::None;
+  Vec3 direction = Vec3::UnitX();  ///< Unit direction of the mean wind.
+  float speed = 0.0f;              ///< Mean wind speed, m/s.
+  float gustAmplitude = 0.0f;      ///< Relative gust strength (0.5 = +-50 %).
+  float gustFrequency = 0.5f;      ///< Hz.
+  float turbulenceScale = 1.0f;    ///< m: spatial scale of the turbulence.
+  float airDensity = 1.2f;         ///< kg/m^3.
+  float dragCoefficient = 1.0f;    ///< Normal (pressure) drag coefficient per triangle.
+  float liftCoefficient = 0.2f;    ///< Lift coefficient per triangle.
+  unsigned seed = 1;               ///< Seeds the deterministic gust field.
+};
+
+struct CapeSettings {
+  Integrator integrator = Integrator::Xpbd;
+
+  /// Spring stiffness per family, N/m per spring (Hooke's k). XPBD uses the compliance 1/k; infinity means
+  /// inextensible. Families: structural, shear, bend.
+  float structuralStiffness = 2.0e4f;
+  float shearStiffness = 2.0e3f;
+  float bendStiffness = 20.0f;
+  bool useTethers = true;  ///< Long-range attachments to pinned anchors (XPBD only).
+
+  /// Linear velocity damping, 1/s: dv/dt = -damping * v (applied as v /= 1 + damping * h).
+  float damping = 0.2f;
+  /// Cape half-thickness kept between particles and collider surfaces, m.
+  float collisionThickness = 0.01f;
+  /// Coulomb friction coefficient against colliders.
+  float friction = 0.3f;
+  /// Substeps per call to step() (h = dt / substeps), >= 1.
+  int substeps = 4;
+  /// Constraint iterations per substep, >= 1.
+  int iterations = 1;
+  /// Gravity, m/s^2.
+  Vec3 gravity = Vec3(0.0f, -9.8f, 0.0f);
+  /// The frame time the settings are tuned for, s (informational and used by validate() to check the explicit
+  /// mode's stability bound).
+  float timeStep = 1.0f / 60.0f;
+
+  WindSettings wind;
+  bool selfCollision = false;  ///< Keep the cape from passing through itself.
+
+  /// The seed's reference set-up: explicit springs, soft, 4 substeps of 0.00875 s per 0.035 s frame.
+  static CapeSettings seed();
+
+  Status validate() const;
+};
+
+}  // namespace cape

@@ -1,0 +1,27 @@
+// CapeState: the per-cape runtime state as structure of arrays.
+#pragma once
+
+#include "cape/core/Types.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace cape {
+
+/// A particle driven to a moving target. Pinned particles have inverse mass 0: nothing else moves them.
+/// Within a step the target moves from `previousTarget` (start of the step) to `target` (end of the step).
+struct Pin {
+  std::uint32_t particle = 0;
+  Vec3 previousTarget = Vec3::Zero();  ///< m, world.
+  Vec3 target = Vec3::Zero();          ///< m, world.
+};
+
+struct CapeState {
+  Points positions;                ///< m, world.
+  Points velocities;               ///< m/s.
+  Eigen::VectorXf inverseMasses;   ///< 1/kg; 0 locks the particle (pins).
+  std::vector<Pin> pins;           ///< At most one pin per particle.
+  double time = 0.0;               ///< s of simulated time since the start.
+};
+
+}  // namespace cape

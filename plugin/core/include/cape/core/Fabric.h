@@ -1,0 +1,123 @@
+// Fabric: the shared, immutable topology and rest state of a cape (NvCloth's Fabric, Jolt's
+// SoftBodySharedSettings). Many capes may share one Fabric; per-cape data lives in CapeState.
+#pragma once
+
+#include "cape/core/Types.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace cape {
+
+/// The families of springs. Structural and shear together form the seed's King's graph for a grid.
+enum class SpringFamily : int { Structural = 0, Shear = 1, Bend = 2 };
+constexpr int kSpringFamilyCount = 3;
+const char* toString(SpringFamily family);
+
+/// Springs of one family as parallel arrays (structure of arrays), solved in this order. The build sorts
+/// them by colour: springs [colourStart[k], colourStart[k+1]) share no particle, so consecutive springs in
+/// the solver loop do not wait on each other (and a colour could be solved in parallel).
+struct SpringSet {
+  std::vector<std::uint32_t> first;   ///< Particle index of one end.
+  std::vector<std::uint32_t> second;  ///< Particle index of the other end.
+  std::vector<float> restLength;      ///< |x_first - x_second| at rest, m (> 0).
+  std::vector<std::uint32_t> colourStart;  ///< Offsets of each colour, plus the end.
+  std::size_t size() const { return first.size(); }
+  std::size_t colourCount() const { return colourStart.empty() ? 0 : colourStart.size() - 1; }
+};
+
+/// Long-range attachments (Kim, Chentanez and Müller 2012, "Long Range Attachments - A Method to Simulate
+/// Inextensible Clothing in Computer Games"): particle `particle` may not be farther than `maxLength` from
+/// particle `anchor` while the anchor is pinned. A unilateral constraint, so it never pushes.
+struct TetherSet {
+  std::vector<std::uint32_t> particle;
+  std::vector<std::uint32_t> anchor;
+  std::vector<float> maxLength;  ///< m; the rest distance times the tether scale.
+  std::size_t size() const { return particle.size(); }
+};
+
+/// How to build a rectangular grid fabric.
+struct GridDesc {
+  int columns = 20;           ///< Particles per row (>= 2).
+  int rows = 20;              ///< Particles per column (>= 2).
+  float width = 0.6f;         ///< m, along +X of the grid's local frame.
+  float height = 1.0f;        ///< m, along -Y: row 0 is the top.
+  float totalMass = 0.4f;     ///< kg, spread evenly over the particles.
+  bool bendSprings = true;    ///< Add bend springs: every second particle along rows and columns.
+  /// Particles to which tethers are made (usually the particles that will be pinned). Empty: no tethers.
+  std::vector<std::uint32_t> tetherAnchors;
+  int tethersPerParticle = 2;  ///< Each particle tethers to this many nearest anchors.
+  float tetherScale = 1.0f;    ///< Tether length = scale * rest distance (>= 1 allows that much stretch).
+};
+
+/// How to build a fabric from any triangle mesh (an artist's cape).
+struct MeshDesc {
+  std::vector<Vec3> positions;           ///< Rest positions, m.
+  std::vector<std::uint32_t> triangles;  ///< Three indices per triangle, counter-clockwise seen from the front.
+  std::vector<Eigen::Vector2f> uvs;      ///< Optional, one per vertex.
+  float totalMass = 0.4f;                ///< kg, spread over vertices in proportion to their triangle area.
+  bool bendSprings = true;               ///< Far vertices of each pair of adjacent triangles.
+  std::vector<std::uint32_t> tetherAnchors;
+  int tethersPerParticle = 2;
+  float tetherScale = 1.0f;
+};
+
+class Fabric;
+using FabricPtr = std::shared_ptr<const Fabric>;
+
+/// The result of building a fabric: the fabric, or an error message.
+struct FabricResult {
+  FabricPtr fabric;
+  Status status = Status::success();
+  explicit operator bool() const { return fabric != nullptr; }
+};
+
+class Fabric {
+ public:
+  /// Builds an N x M grid in its local frame: particle (r, c) has index r * columns + c and rest position
+  /// (c * width / (columns - 1), -r * height / (rows - 1), 0): row-major from the top-left seen from +Z.
+  /// Springs: structural (rows and columns), shear (both diagonals of every cell) — the King's graph, with
+  /// exactly 4nm - 3(n + m) + 2 springs — and optional bend springs. Two counter-clockwise triangles per cell.
+  static FabricResult grid(const GridDesc& desc);
+  /// Builds from a triangle mesh: every mesh edge a structural spring, the far vertices of every two
+  /// triangles sharing an edge a bend spring. No shear family (the triangles' edges already brace them).
+  static FabricResult fromMesh(const MeshDesc& desc);
+
+  std::size_t particleCount() const { return static_cast<std::size_t>(restPositions_.rows()); }
+  const Points& restPositions() const { return restPositions_; }
+  const Eigen::VectorXf& masses() const { return masses_; }  ///< kg per particle (> 0).
+  const SpringSet& springs(SpringFamily family) const { return springs_[static_cast<int>(family)]; }
+  std::size_t springCount() const;  ///< All families together.
+  const TetherSet& tethers() const { return tethers_; }
+  const std::vector<std::uint32_t>& triangles() const { return triangles_; }  ///< 3 per triangle, CCW.
+  std::size_t triangleCount() const { return triangles_.size() / 3; }
+  const std::vector<Eigen::Vector2f>& uvs() const { return uvs_; }
+  float totalMass() const { return static_cast<float>(masses_.sum()); }
+  /// Grid dimensions, when built by grid(); 0 otherwise.
+  int gridColumns() const { return gridColumns_; }
+  int gridRows() const { return gridRows_; }
+  /// The largest distance between two particles at rest (bounds how far any particle can be from a pin).
+  float restDiameter() const { return restDiameter_; }
+
+ private:
+  Fabric() = default;
+  /// Derived data in one explicit pass: rest lengths, tethers, diameter. Returns an error on degenerate input.
+  Status finish(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale);
+
+  Points restPositions_;
+  Eigen::VectorXf masses_;
+  SpringSet springs_[kSpringFamilyCount];
+  TetherSet tethers_;
+  std::vector<std::uint32_t> triangles_;
+  std::vector<Eigen::Vector2f> uvs_;
+  int gridColumns_ = 0;
+  int gridRows_ = 0;
+  float restDiameter_ = 0.0f;
+};
+
+/// The seed's spring count for an n x m King's graph: 4nm - 3(n + m) + 2.
+constexpr long kingsGraphSpringCount(long n, long m) { return 4 * n * m - 3 * (n + m) + 2; }
+
+}  // namespace cape

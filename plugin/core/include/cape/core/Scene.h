@@ -1,0 +1,106 @@
+// The canonical scenes of shared/SCENARIOS.md on the simple body, with no Bullet: tests, benchmarks and the
+// demos' --simple-body mode drive the solver exactly alike.
+#pragma once
+
+#include "cape/core/Cape.h"
+
+#include <string>
+#include <vector>
+
+namespace cape {
+
+enum class SceneKind : int { Hang, Walk, SprintTurn, Wind, Crowd };
+const char* toString(SceneKind kind);
+/// Parses "hang", "walk", "sprint-turn", "wind", "crowd"; false if unknown.
+bool parseSceneKind(const std::string& name, SceneKind& kind);
+
+enum class Attachment : int { Corners, Collar };
+const char* toString(Attachment attachment);
+bool parseAttachment(const std::string& name, Attachment& attachment);
+
+/// How the character moves in a scene. Times in s, lengths in m, angles in rad.
+struct MotionDesc {
+  float speed = 0.0f;           ///< m/s along the heading
+  float legFrequency = 0.0f;    ///< Hz, one full leg swing per period
+  float legAmplitude = 0.5236f; ///< rad (30 degrees)
+  float bobAmplitude = 0.0f;    ///< m, half the peak-to-peak torso bob
+  float bobFrequency = 0.0f;    ///< Hz
+  bool turns = false;           ///< sprint-turn: 180 degrees in the last turnDuration of every turnPeriod
+  float turnPeriod = 2.0f;
+  float turnDuration = 0.5f;
+  float duration = 10.0f;       ///< s, the scene's length
+
+  static MotionDesc forScene(SceneKind kind);
+};
+
+/// The character's pose at a time: its frame (origin on the ground between the feet, facing -Z when yaw = 0),
+/// the torso bob and the left leg angle (the right leg is its negative).
+struct BodyPose {
+  Vec3 position = Vec3::Zero();
+  float yaw = 0.0f;  ///< rad about +Y
+  float bob = 0.0f;  ///< m, added to every body part's height
+  float legAngle = 0.0f;
+  Pose frame() const;  ///< The character frame in the world, bob included.
+};
+
+/// Exact pose at time t (closed form, independent of the step size).
+BodyPose motionAt(const MotionDesc& motion, double t);
+
+/// The simple body of SCENARIOS.md: torso box, shoulder spheres, leg capsules and the ground plane.
+/// Collider order: torso, left shoulder, right shoulder, left leg, right leg, ground.
+class SimpleBody {
+ public:
+  static constexpr int kTorso = 0, kLeftShoulder = 1, kRightShoulder = 2, kLeftLeg = 3, kRightLeg = 4, kGround = 5;
+  explicit SimpleBody(const Vec3& offset = Vec3::Zero());
+  /// Body colliders only (not the ground), for the penetration metric.
+  ColliderSpan bodyColliders() const { return ColliderSpan(colliders_.data(), colliders_.size() - 1); }
+  const std::vector<Collider>& colliders() const { return colliders_; }
+  /// Moves every body collider to the pose (sweeping from where it was); teleport = no sweep.
+  void moveTo(const BodyPose& pose, bool teleport = false);
+  /// Centre of the torso in the world at the current pose.
+  Vec3 torsoCentre() const { return colliders_[kTorso].current.position; }
+
+ private:
+  std::vector<Collider> colliders_;
+  Vec3 offset_;  ///< Where the character stands in the world (crowd members are side by side).
+};
+
+/// Character-frame attachment points: "corners" pins the top corners at (+-0.30, 1.56, 0.15); "collar" pins
+/// the whole top row along the same line.
+struct CapeRig {
+  FabricPtr fabric;
+  std::vector<std::uint32_t> pinnedParticles;  ///< Fabric particle indices
+  std::vector<Vec3> pinLocalPoints;            ///< in the character frame, m
+};
+/// The canonical N x N cape (0.6 m x 1.0 m, 0.4 kg) with tethers to its attachment particles.
+CapeRig makeCapeRig(int n, Attachment attachment, bool bendSprings = true);
+/// The cape's starting placement in the character frame: flat and vertical at z = 0.15 with its top row on
+/// the pins, or for "hang" flat and horizontal reaching from the pins towards +Z.
+Pose capeStartPlacement(SceneKind kind);
+
+/// One cape on the simple body, stepped frame by frame: what tests and benchmarks run.
+class SimpleScene {
+ public:
+  SimpleScene(SceneKind kind, int n, Attachment attachment, const CapeSettings& settings,
+              const Vec3& offset = Vec3::Zero());
+  const Status& status() const { return cape_.status(); }
+  /// Advances one frame of dt seconds: moves the body and the pins, then steps the cape.
+  void advanceFrame(float dt = 1.0f / 60.0f);
+  double time() const { return time_; }
+  const MotionDesc& motion() const { return motion_; }
+  Cape& cape() { return cape_; }
+  const Cape& cape() const { return cape_; }
+  const SimpleBody& body() const { return body_; }
+  const CapeRig& rig() const { return rig_; }
+
+ private:
+  SceneKind kind_;
+  MotionDesc motion_;
+  CapeRig rig_;
+  SimpleBody body_;
+  Cape cape_;
+  Vec3 offset_;
+  double time_ = 0.0;
+};
+
+}  // namespace cape

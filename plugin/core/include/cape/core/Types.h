@@ -1,0 +1,55 @@
+// Basic types of the cape core: vectors, poses and the status value that reports bad input.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace cape {
+
+using Vec3 = Eigen::Vector3f;
+using Quat = Eigen::Quaternionf;
+
+/// Particle data as structure of arrays: row i is particle i, column 0 holds every x, column 1 every y,
+/// column 2 every z (Eigen's column-major storage keeps each coordinate contiguous, so per-particle loops
+/// vectorise).
+using Points = Eigen::Matrix<float, Eigen::Dynamic, 3>;
+
+/// A rigid transform: x_world = rotation * x_local + position. Units: metres.
+struct Pose {
+  Vec3 position = Vec3::Zero();
+  Quat rotation = Quat::Identity();  ///< Unit quaternion.
+
+  Vec3 apply(const Vec3& local) const { return rotation * local + position; }
+  Vec3 applyInverse(const Vec3& world) const { return rotation.conjugate() * (world - position); }
+  bool isFinite() const;
+
+  /// Pose a fraction s in [0, 1] of the way from a to b: positions interpolated linearly, rotations along
+  /// the shortest arc (slerp). s = 0 gives a and s = 1 gives b exactly.
+  static Pose interpolate(const Pose& a, const Pose& b, float s);
+};
+
+/// The result of an operation that can fail on bad data: ok, or an error message meant for a person.
+class Status {
+ public:
+  static Status success() { return Status(); }
+  static Status error(std::string message) { return Status(std::move(message)); }
+  bool ok() const { return message_.empty(); }
+  explicit operator bool() const { return ok(); }
+  const std::string& message() const { return message_; }
+
+ private:
+  Status() = default;
+  explicit Status(std::string message) : message_(std::move(message)) {
+    if (message_.empty()) message_ = "unknown error";
+  }
+  std::string message_;
+};
+
+inline bool isFinite(const Vec3& v) { return v.allFinite(); }
+
+}  // namespace cape

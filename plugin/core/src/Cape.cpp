@@ -1,0 +1,319 @@
+#include "cape/core/Cape.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace cape {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+float stiffnessOf(const CapeSettings& s, int family) {
+  switch (static_cast<SpringFamily>(family)) {
+    case SpringFamily::Structural: return s.structuralStiffness;
+    case SpringFamily::Shear: return s.shearStiffness;
+    case SpringFamily::Bend: return s.bendStiffness;
+  }
+  return 0.0f;
+}
+
+}  // namespace
+
+/// The largest substep the explicit integrator can take without blowing up. Symplectic Euler on a linear
+/// spring system is stable while h * omega_max < 2, i.e. h^2 * lambda_max(M^-1 K) < 4; Gershgorin's theorem
+/// bounds lambda_max by max over particles i of sum over springs (i, j) of k * (w_i + w_j).
+static float explicitStableStep(const Fabric& fabric, const CapeSettings& settings) {
+  Eigen::VectorXf bound = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.particleCount()));
+  const Eigen::VectorXf& m = fabric.masses();
+  for (int f = 0; f < kSpringFamilyCount; ++f) {
+    const float k = stiffnessOf(settings, f);
+    if (k <= 0.0f) continue;
+    const SpringSet& set = fabric.springs(static_cast<SpringFamily>(f));
+    for (std::size_t s = 0; s < set.size(); ++s) {
+      const float w = 1.0f / m[set.first[s]] + 1.0f / m[set.second[s]];
+      bound[set.first[s]] += k * w;
+      bound[set.second[s]] += k * w;
+    }
+  }
+  const float lambdaMax = bound.maxCoeff();
+  return lambdaMax > 0.0f ? 2.0f / std::sqrt(lambdaMax) : kInf;
+}
+
+Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement)
+    : fabric_(std::move(fabric)), settings_(settings) {
+  if (!fabric_) {
+    status_ = Status::error("Cape: no fabric");
+    return;
+  }
+  if (!placement.isFinite()) {
+    status_ = Status::error("Cape: placement pose is not finite");
+    return;
+  }
+  status_ = setSettings(settings);
+  if (!status_.ok()) return;
+  const Eigen::Index n = static_cast<Eigen::Index>(fabric_->particleCount());
+  state_.positions.resize(n, 3);
+  const Eigen::Matrix3f r = placement.rotation.toRotationMatrix();
+  for (Eigen::Index i = 0; i < n; ++i)
+    state_.positions.row(i) = (r * fabric_->restPositions().row(i).transpose() + placement.position).transpose();
+  state_.velocities = Points::Zero(n, 3);
+  state_.inverseMasses = fabric_->masses().cwiseInverse();
+  startPositions_ = state_.positions;
+  acceleration_ = Points::Zero(n, 3);
+  freeMask_ = Eigen::VectorXf::Ones(n);
+  lambda_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric_->springCount()));
+  colliderStart_.reserve(64);
+  colliderEnd_.reserve(64);
+  state_.pins.reserve(static_cast<std::size_t>(n));
+}
+
+Status Cape::setSettings(const CapeSettings& settings) {
+  Status s = settings.validate();
+  if (!s.ok()) return s;
+  if (settings.integrator == Integrator::ExplicitSpring) {
+    const float hMax = explicitStableStep(*fabric_, settings);
+    const float h = settings.timeStep / static_cast<float>(settings.substeps);
+    if (h >= hMax) {
+      return Status::error("CapeSettings: the explicit integrator is unstable for this fabric: substep " +
+                           std::to_string(h) + " s >= stability bound " + std::to_string(hMax) +
+                           " s; lower the stiffness or raise the substeps");
+    }
+  }
+  settings_ = settings;
+  familyCompliance_.assign(kSpringFamilyCount, 0.0f);
+  for (int f = 0; f < kSpringFamilyCount; ++f) {
+    const float k = stiffnessOf(settings_, f);
+    familyCompliance_[static_cast<std::size_t>(f)] = k > 0.0f ? 1.0f / k : kInf;  // inf compliance = off
+  }
+  return Status::success();
+}
+
+std::size_t Cape::pin(std::uint32_t particle, const Vec3& target) {
+  if (!ok() || particle >= fabric_->particleCount() || !target.allFinite()) return static_cast<std::size_t>(-1);
+  for (std::size_t k = 0; k < state_.pins.size(); ++k) {
+    if (state_.pins[k].particle == particle) {
+      state_.pins[k].previousTarget = state_.pins[k].target = target;
+      return k;
+    }
+  }
+  state_.inverseMasses[particle] = 0.0f;
+  state_.pins.push_back({particle, target, target});
+  return state_.pins.size() - 1;
+}
+
+void Cape::unpin(std::uint32_t particle) {
+  if (!ok() || particle >= fabric_->particleCount()) return;
+  auto it = std::find_if(state_.pins.begin(), state_.pins.end(), [&](const Pin& p) { return p.particle == particle; });
+  if (it == state_.pins.end()) return;
+  state_.pins.erase(it);
+  state_.inverseMasses[particle] = 1.0f / fabric_->masses()[particle];
+}
+
+void Cape::movePin(std::size_t k, const Vec3& target) {
+  if (k >= state_.pins.size()) return;
+  Pin& p = state_.pins[k];
+  p.previousTarget = p.target;
+  if (target.allFinite()) p.target = target;  // a non-finite target is ignored: the pin holds still
+}
+
+void Cape::teleport(const Pose& delta) {
+  if (!ok() || !delta.isFinite()) return;
+  const Eigen::Matrix3f r = delta.rotation.toRotationMatrix();
+  for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
+    state_.positions.row(i) = (r * state_.positions.row(i).transpose() + delta.position).transpose();
+    state_.velocities.row(i) = (r * state_.velocities.row(i).transpose()).transpose();
+  }
+  for (Pin& p : state_.pins) {
+    p.previousTarget = delta.apply(p.previousTarget);
+    p.target = delta.apply(p.target);
+  }
+}
+
+void Cape::step(float dt, ColliderSpan colliders) {
+  if (!ok() || !std::isfinite(dt) || !(dt > 0.0f)) return;
+  int substeps = settings_.substeps;
+  if (settings_.integrator == Integrator::ExplicitSpring) {
+    // A longer step than the settings were checked for: split it further rather than blow up.
+    const float hMax = explicitStableStep(*fabric_, settings_);
+    substeps = std::max(substeps, static_cast<int>(std::ceil(dt / (0.9f * hMax))));
+  }
+  const float h = dt / static_cast<float>(substeps);
+  // 1 for free particles, 0 for pinned ones (same size every step: no allocation).
+  freeMask_ = (state_.inverseMasses.array() > 0.0f).cast<float>();
+  for (int k = 0; k < substeps; ++k) {
+    const float s0 = static_cast<float>(k) / static_cast<float>(substeps);
+    const float s1 = static_cast<float>(k + 1) / static_cast<float>(substeps);
+    if (settings_.integrator == Integrator::Xpbd)
+      stepXpbd(h, s0, s1, colliders);
+    else
+      stepExplicit(h, s0, s1, colliders);
+  }
+  for (Pin& p : state_.pins) p.previousTarget = p.target;
+  state_.time += static_cast<double>(dt);
+}
+
+void Cape::movePinsTo(float s, float h) {
+  const float invH = 1.0f / h;
+  for (const Pin& p : state_.pins) {
+    const Vec3 target = p.previousTarget + s * (p.target - p.previousTarget);
+    const Eigen::Index i = p.particle;
+    state_.velocities.row(i) = (target.transpose() - state_.positions.row(i)) * invH;
+    state_.positions.row(i) = target.transpose();
+  }
+}
+
+void Cape::accumulateExternalAcceleration(float /*t*/) {
+  // Gravity on free particles only: pinned particles (inverse mass 0) feel nothing.
+  for (int c = 0; c < 3; ++c) acceleration_.col(c) = freeMask_ * settings_.gravity[c];
+}
+
+void Cape::stepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
+  startPositions_ = state_.positions;
+  accumulateExternalAcceleration(static_cast<float>(state_.time) + s1 * h);
+  // Predict: x* = x + h v + h^2 a (symplectic Euler on the external forces).
+  state_.velocities += h * acceleration_;
+  state_.positions += h * state_.velocities;
+  movePinsTo(s1, h);
+  lambda_.setZero();
+  for (int it = 0; it < settings_.iterations; ++it) {
+    solveSprings(h);
+    if (settings_.useTethers) solveTethers();
+  }
+  collide(h, s0, s1, colliders, false);
+  // New velocities from the position change, then damping: dv/dt = -c v integrated implicitly
+  // (v <- v / (1 + c h), the Padé approximation of exp(-c h), unconditionally stable).
+  const float scale = 1.0f / (h * (1.0f + settings_.damping * h));
+  for (int c = 0; c < 3; ++c) {
+    state_.velocities.col(c) = freeMask_.cwiseProduct(state_.positions.col(c) - startPositions_.col(c)) * scale +
+                               (1.0f - freeMask_.array()).matrix().cwiseProduct(state_.velocities.col(c));
+  }
+}
+
+void Cape::solveSprings(float h) {
+  float* px = state_.positions.col(0).data();
+  float* py = state_.positions.col(1).data();
+  float* pz = state_.positions.col(2).data();
+  const float* w = state_.inverseMasses.data();
+  float* lambda = lambda_.data();
+  const float invH2 = 1.0f / (h * h);
+  for (int f = 0; f < kSpringFamilyCount; ++f) {
+    const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
+    const float compliance = familyCompliance_[static_cast<std::size_t>(f)];
+    if (std::isinf(compliance)) {
+      lambda += set.size();
+      continue;
+    }
+    // XPBD distance constraint C = |xj - xi| - L with compliance alpha (Macklin et al. 2016):
+    //   dlambda = (-C - alpha~ lambda) / (wi + wj + alpha~),  alpha~ = alpha / h^2,
+    //   xi -= wi dlambda n,  xj += wj dlambda n,  n = (xj - xi) / |xj - xi|.
+    const float alpha = compliance * invH2;
+    const std::uint32_t* first = set.first.data();
+    const std::uint32_t* second = set.second.data();
+    const float* rest = set.restLength.data();
+    const std::size_t count = set.size();
+    for (std::size_t s = 0; s < count; ++s) {
+      const std::uint32_t i = first[s], j = second[s];
+      const float wsum = w[i] + w[j];
+      if (wsum <= 0.0f) continue;
+      const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
+      const float len2 = dx * dx + dy * dy + dz * dz;
+      if (len2 < 1e-18f) continue;
+      const float len = std::sqrt(len2);
+      const float dl = (rest[s] - len - alpha * lambda[s]) / (wsum + alpha);
+      lambda[s] += dl;
+      const float k = dl / len;
+      const float cx = k * dx, cy = k * dy, cz = k * dz;
+      px[i] -= w[i] * cx;
+      py[i] -= w[i] * cy;
+      pz[i] -= w[i] * cz;
+      px[j] += w[j] * cx;
+      py[j] += w[j] * cy;
+      pz[j] += w[j] * cz;
+    }
+    lambda += count;
+  }
+}
+
+void Cape::solveTethers() {
+  const TetherSet& t = fabric_->tethers();
+  float* px = state_.positions.col(0).data();
+  float* py = state_.positions.col(1).data();
+  float* pz = state_.positions.col(2).data();
+  const float* w = state_.inverseMasses.data();
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const std::uint32_t a = t.anchor[k], p = t.particle[k];
+    if (w[a] != 0.0f || w[p] == 0.0f) continue;  // only while the anchor is pinned
+    const float dx = px[p] - px[a], dy = py[p] - py[a], dz = pz[p] - pz[a];
+    const float len2 = dx * dx + dy * dy + dz * dz;
+    const float maxLen = t.maxLength[k];
+    if (len2 <= maxLen * maxLen) continue;
+    const float scale = maxLen / std::sqrt(len2);
+    px[p] = px[a] + dx * scale;
+    py[p] = py[a] + dy * scale;
+    pz[p] = pz[a] + dz * scale;
+  }
+}
+
+void Cape::stepExplicit(float h, float s0, float s1, ColliderSpan colliders) {
+  // The seed: F = m g - m c v + sum of Hooke forces k (|d| - L) d / |d|; v += h F / m; x += h v.
+  accumulateExternalAcceleration(static_cast<float>(state_.time) + s1 * h);
+  const float* px = state_.positions.col(0).data();
+  const float* py = state_.positions.col(1).data();
+  const float* pz = state_.positions.col(2).data();
+  float* ax = acceleration_.col(0).data();
+  float* ay = acceleration_.col(1).data();
+  float* az = acceleration_.col(2).data();
+  const float* w = state_.inverseMasses.data();
+  for (int f = 0; f < kSpringFamilyCount; ++f) {
+    const float k = stiffnessOf(settings_, f);
+    if (k <= 0.0f) continue;
+    const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
+    for (std::size_t s = 0; s < set.size(); ++s) {
+      const std::uint32_t i = set.first[s], j = set.second[s];
+      const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
+      const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (len < 1e-9f) continue;
+      const float fs = k * (len - set.restLength[s]) / len;  // force on i along d, N/m * m / m
+      ax[i] += w[i] * fs * dx;
+      ay[i] += w[i] * fs * dy;
+      az[i] += w[i] * fs * dz;
+      ax[j] -= w[j] * fs * dx;
+      ay[j] -= w[j] * fs * dy;
+      az[j] -= w[j] * fs * dz;
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    acceleration_.col(c) -= settings_.damping * freeMask_.cwiseProduct(state_.velocities.col(c));
+  }
+  state_.velocities += h * acceleration_;
+  startPositions_ = state_.positions;
+  state_.positions += h * state_.velocities;
+  movePinsTo(s1, h);
+  collide(h, s0, s1, colliders, true);
+}
+
+double Cape::energy() const {
+  if (!ok()) return 0.0;
+  double e = 0.0;
+  const Eigen::VectorXf& m = fabric_->masses();
+  for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
+    const double mi = m[i];
+    e += 0.5 * mi * static_cast<double>(state_.velocities.row(i).squaredNorm());
+    e -= mi * static_cast<double>(settings_.gravity.dot(state_.positions.row(i).transpose()));
+  }
+  for (int f = 0; f < kSpringFamilyCount; ++f) {
+    const double k = stiffnessOf(settings_, f);
+    if (!(k > 0.0) || std::isinf(k)) continue;
+    const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
+    for (std::size_t s = 0; s < set.size(); ++s) {
+      const double len = (state_.positions.row(set.first[s]) - state_.positions.row(set.second[s])).norm();
+      const double ext = len - set.restLength[s];
+      e += 0.5 * k * ext * ext;
+    }
+  }
+  return e;
+}
+
+}  // namespace cape

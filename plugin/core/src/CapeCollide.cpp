@@ -1,0 +1,162 @@
+// The collision stage of a substep: every free particle against every collider's sweep over the substep.
+#include "cape/core/Cape.h"
+
+#include "ShapeDistance.h"
+
+#include <cmath>
+#include <limits>
+
+namespace cape {
+
+namespace {
+
+// Radius of a sphere about the collider's origin that holds the whole shape (infinite for planes).
+float boundingRadius(const Collider& c) {
+  switch (c.shape) {
+    case ColliderShape::Sphere: return c.radius;
+    case ColliderShape::Capsule: return c.radius + c.halfHeight;
+    case ColliderShape::Cylinder: return std::hypot(c.radius, c.halfHeight);
+    case ColliderShape::Box: return c.halfExtents.norm();
+    case ColliderShape::Plane: return std::numeric_limits<float>::infinity();
+  }
+  return std::numeric_limits<float>::infinity();
+}
+
+struct ParticleArrays {
+  float* px;
+  float* py;
+  float* pz;
+  const float* sx;  ///< positions at the start of the substep
+  const float* sy;
+  const float* sz;
+  const float* w;
+  float* vx;  ///< velocities, corrected only in the explicit mode
+  float* vy;
+  float* vz;
+  Eigen::Index n;
+};
+
+/// One collider against every free particle. In the collider's own frame the collider is still and the
+/// particle moves from a (its start, in the frame's pose at s0) to b (its prediction, in the pose at s1):
+/// relative motion, so a fast collider and a fast particle are the same problem.
+template <ColliderShape S>
+void collideWith(const Collider& c, const ParticleArrays& p, float s0, float s1, float margin, float mu,
+                 float invH, bool explicitMode) {
+  using detail::shapeDistance;
+  const Pose A = Pose::interpolate(c.previous, c.current, s0);
+  const Pose B = Pose::interpolate(c.previous, c.current, s1);
+  const Eigen::Matrix3f invRA = A.rotation.conjugate().toRotationMatrix();
+  const Eigen::Matrix3f invRB = B.rotation.conjugate().toRotationMatrix();
+  const Eigen::Matrix3f RB = B.rotation.toRotationMatrix();
+  const float bound = boundingRadius(c);
+  const float shift = (B.position - A.position).norm();
+  const float turn = A.rotation.angularDistance(B.rotation);  // rad over the substep
+
+  for (Eigen::Index i = 0; i < p.n; ++i) {
+    if (p.w[i] == 0.0f) continue;
+    const Vec3 x(p.px[i], p.py[i], p.pz[i]);
+    const Vec3 x0(p.sx[i], p.sy[i], p.sz[i]);
+    const Vec3 rel = x - B.position;
+    const float travel = (x - x0).norm();
+    float sweep = travel + shift;
+    if constexpr (S != ColliderShape::Plane) {
+      // How far the particle moves relative to the collider's frame, at most: its own travel plus the
+      // collider's translation and its rotation at this distance from the origin.
+      const float relNorm = rel.norm();
+      sweep += turn * (relNorm + travel);
+      if (relNorm > bound + margin + sweep) continue;  // cannot touch in this substep
+    }
+    const Vec3 b = invRB * rel;
+    const SurfaceDistance sb = shapeDistance<S>(c, b);
+    // The signed distance is 1-Lipschitz: if the end is farther than the whole relative motion, the segment
+    // never came within the margin.
+    if (sb.distance >= margin + sweep) continue;
+    const Vec3 a = invRA * (x0 - A.position);
+    const SurfaceDistance sa = shapeDistance<S>(c, a);
+    Vec3 bn = b;
+    Vec3 normal = sb.normal;
+    bool touched = false;
+    const Vec3 ab = b - a;
+    const float len = ab.norm();
+    // Both ends clear, but the motion is long enough to tunnel through a thin part (along the segment
+    // d >= (d(a) + d(b) - len) / 2): conservative advancement from a finds the first contact.
+    if (sa.distance >= margin && sb.distance >= margin && sa.distance + sb.distance - len < 2.0f * margin) {
+      float t = 0.0f;
+      SurfaceDistance s = sa;
+      bool hit = false;
+      for (int iter = 0; iter < 32; ++iter) {
+        const float gap = s.distance - margin;
+        if (gap < 1e-5f) {
+          hit = true;
+          break;
+        }
+        // The rest of the segment clears the margin: no contact.
+        if (s.distance + sb.distance - (1.0f - t) * len >= 2.0f * margin) break;
+        t += gap / len;
+        if (t >= 1.0f) break;
+        s = shapeDistance<S>(c, a + t * ab);
+      }
+      if (hit) {
+        // Stop at the contact: keep only the motion along the tangent plane of the contact point.
+        const Vec3 pc = a + t * ab;
+        normal = s.normal;
+        bn = b + std::max(0.0f, (pc - b).dot(normal)) * normal;
+        touched = true;
+      }
+    }
+    // Whatever the sweep found, end outside the skin: push out to the nearest surface point plus the margin
+    // (the seed's push-out; it also covers particles that started inside, e.g. after a pose jump).
+    const SurfaceDistance sn = touched ? shapeDistance<S>(c, bn) : sb;
+    if (sn.distance < margin) {
+      bn += (margin - sn.distance) * sn.normal;
+      if (!touched) normal = sn.normal;
+      touched = true;
+    }
+    if (!touched) continue;
+    // Coulomb friction on the tangential displacement relative to the collider (Macklin et al. 2014,
+    // "Unified Particle Physics for Real-Time Applications"): static while within mu times the normal
+    // correction, otherwise shortened by that much.
+    const float normalCorrection = (bn - b).norm();
+    if (mu > 0.0f && normalCorrection > 0.0f) {
+      const Vec3 moved = bn - a;
+      const Vec3 tangential = moved - moved.dot(normal) * normal;
+      const float tl = tangential.norm();
+      const float limit = mu * normalCorrection;
+      bn -= tl <= limit ? tangential : Vec3(tangential * (limit / tl));
+    }
+    const Vec3 xn = RB * bn + B.position;
+    if (explicitMode) {
+      // The seed moves positions only; keep the velocity consistent with the correction.
+      p.vx[i] += (xn.x() - x.x()) * invH;
+      p.vy[i] += (xn.y() - x.y()) * invH;
+      p.vz[i] += (xn.z() - x.z()) * invH;
+    }
+    p.px[i] = xn.x();
+    p.py[i] = xn.y();
+    p.pz[i] = xn.z();
+  }
+}
+
+}  // namespace
+
+void Cape::collide(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode) {
+  ParticleArrays p{state_.positions.col(0).data(),  state_.positions.col(1).data(),  state_.positions.col(2).data(),
+                   startPositions_.col(0).data(),   startPositions_.col(1).data(),   startPositions_.col(2).data(),
+                   state_.inverseMasses.data(),     state_.velocities.col(0).data(), state_.velocities.col(1).data(),
+                   state_.velocities.col(2).data(), state_.positions.rows()};
+  const float invH = 1.0f / h;
+  for (const Collider& c : colliders) {
+    if (!c.validate().ok()) continue;  // documented: an invalid collider (NaN pose, bad size) is skipped
+    const float margin = settings_.collisionThickness + c.thickness;
+    const float mu = c.friction >= 0.0f ? c.friction : settings_.friction;
+    switch (c.shape) {
+      case ColliderShape::Sphere: collideWith<ColliderShape::Sphere>(c, p, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::Capsule: collideWith<ColliderShape::Capsule>(c, p, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::Cylinder: collideWith<ColliderShape::Cylinder>(c, p, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::Box: collideWith<ColliderShape::Box>(c, p, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::Plane: collideWith<ColliderShape::Plane>(c, p, s0, s1, margin, mu, invH, explicitMode); break;
+    }
+  }
+}
+
+}  // namespace cape

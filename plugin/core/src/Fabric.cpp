@@ -1,0 +1,264 @@
+#include "cape/core/Fabric.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <utility>
+
+namespace cape {
+
+const char* toString(SpringFamily family) {
+  switch (family) {
+    case SpringFamily::Structural: return "structural";
+    case SpringFamily::Shear: return "shear";
+    case SpringFamily::Bend: return "bend";
+  }
+  return "?";
+}
+
+std::size_t Fabric::springCount() const {
+  std::size_t n = 0;
+  for (const auto& s : springs_) n += s.size();
+  return n;
+}
+
+namespace {
+
+void addSpring(SpringSet& set, std::uint32_t a, std::uint32_t b) {
+  set.first.push_back(a);
+  set.second.push_back(b);
+}
+
+bool finitePositive(float v) { return std::isfinite(v) && v > 0.0f; }
+
+// Greedy graph colouring of a family's springs (first fit, in build order), then a stable sort by colour.
+// Within a colour no two springs share a particle.
+void colour(SpringSet& set, std::size_t particles) {
+  std::vector<std::vector<bool>> used(particles);
+  std::vector<std::uint32_t> colourOf(set.size());
+  std::uint32_t colours = 0;
+  for (std::size_t s = 0; s < set.size(); ++s) {
+    auto& a = used[set.first[s]];
+    auto& b = used[set.second[s]];
+    std::uint32_t c = 0;
+    while ((c < a.size() && a[c]) || (c < b.size() && b[c])) ++c;
+    if (a.size() <= c) a.resize(c + 1, false);
+    if (b.size() <= c) b.resize(c + 1, false);
+    a[c] = b[c] = true;
+    colourOf[s] = c;
+    colours = std::max(colours, c + 1);
+  }
+  std::vector<std::size_t> order(set.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t l, std::size_t r) { return colourOf[l] < colourOf[r]; });
+  SpringSet sorted;
+  sorted.colourStart.assign(colours + 1, 0);
+  for (std::size_t k : order) {
+    sorted.first.push_back(set.first[k]);
+    sorted.second.push_back(set.second[k]);
+    ++sorted.colourStart[colourOf[k] + 1];
+  }
+  for (std::uint32_t c = 0; c < colours; ++c) sorted.colourStart[c + 1] += sorted.colourStart[c];
+  set = std::move(sorted);
+}
+
+}  // namespace
+
+FabricResult Fabric::grid(const GridDesc& d) {
+  FabricResult result;
+  if (d.columns < 2 || d.rows < 2) {
+    result.status = Status::error("Fabric::grid: needs at least 2 x 2 particles, got " +
+                                  std::to_string(d.columns) + " x " + std::to_string(d.rows));
+    return result;
+  }
+  if (static_cast<long>(d.columns) * d.rows > (1L << 24)) {
+    result.status = Status::error("Fabric::grid: too many particles");
+    return result;
+  }
+  if (!finitePositive(d.width) || !finitePositive(d.height) || !finitePositive(d.totalMass)) {
+    result.status = Status::error("Fabric::grid: width, height and total mass must be finite and > 0");
+    return result;
+  }
+  std::shared_ptr<Fabric> f(new Fabric());
+  const int nc = d.columns, nr = d.rows;
+  const int n = nc * nr;
+  auto id = [nc](int r, int c) { return static_cast<std::uint32_t>(r * nc + c); };
+  f->gridColumns_ = nc;
+  f->gridRows_ = nr;
+  f->restPositions_.resize(n, 3);
+  f->uvs_.resize(n);
+  for (int r = 0; r < nr; ++r) {
+    for (int c = 0; c < nc; ++c) {
+      const float u = static_cast<float>(c) / static_cast<float>(nc - 1);
+      const float v = static_cast<float>(r) / static_cast<float>(nr - 1);
+      f->restPositions_.row(id(r, c)) << u * d.width, -v * d.height, 0.0f;
+      f->uvs_[id(r, c)] = Eigen::Vector2f(u, v);
+    }
+  }
+  f->masses_ = Eigen::VectorXf::Constant(n, d.totalMass / static_cast<float>(n));
+
+  SpringSet& structural = f->springs_[static_cast<int>(SpringFamily::Structural)];
+  SpringSet& shear = f->springs_[static_cast<int>(SpringFamily::Shear)];
+  SpringSet& bend = f->springs_[static_cast<int>(SpringFamily::Bend)];
+  // Rows first, then columns: the order in which Gauss-Seidel visits them (fixed, so results are
+  // deterministic).
+  for (int r = 0; r < nr; ++r)
+    for (int c = 0; c + 1 < nc; ++c) addSpring(structural, id(r, c), id(r, c + 1));
+  for (int r = 0; r + 1 < nr; ++r)
+    for (int c = 0; c < nc; ++c) addSpring(structural, id(r, c), id(r + 1, c));
+  for (int r = 0; r + 1 < nr; ++r) {
+    for (int c = 0; c + 1 < nc; ++c) {
+      addSpring(shear, id(r, c), id(r + 1, c + 1));
+      addSpring(shear, id(r, c + 1), id(r + 1, c));
+    }
+  }
+  if (d.bendSprings) {
+    for (int r = 0; r < nr; ++r)
+      for (int c = 0; c + 2 < nc; ++c) addSpring(bend, id(r, c), id(r, c + 2));
+    for (int r = 0; r + 2 < nr; ++r)
+      for (int c = 0; c < nc; ++c) addSpring(bend, id(r, c), id(r + 2, c));
+  }
+  // Two triangles per cell, counter-clockwise seen from +Z (x right, y up):
+  //   (r,c) ---- (r,c+1)        top-left a, top-right b
+  //     |      /   |
+  //   (r+1,c) -- (r+1,c+1)      bottom-left c, bottom-right e
+  // triangles (c, e, b) and (c, b, a).
+  f->triangles_.reserve(static_cast<std::size_t>((nr - 1) * (nc - 1) * 6));
+  for (int r = 0; r + 1 < nr; ++r) {
+    for (int c = 0; c + 1 < nc; ++c) {
+      const std::uint32_t a = id(r, c), b = id(r, c + 1), cc = id(r + 1, c), e = id(r + 1, c + 1);
+      f->triangles_.insert(f->triangles_.end(), {cc, e, b, cc, b, a});
+    }
+  }
+  result.status = f->finish(d.tetherAnchors, d.tethersPerParticle, d.tetherScale);
+  if (result.status.ok()) result.fabric = std::move(f);
+  return result;
+}
+
+FabricResult Fabric::fromMesh(const MeshDesc& d) {
+  FabricResult result;
+  const std::size_t n = d.positions.size();
+  if (n < 3 || d.triangles.empty() || d.triangles.size() % 3 != 0) {
+    result.status = Status::error("Fabric::fromMesh: needs at least one triangle (3 indices each) over 3+ vertices");
+    return result;
+  }
+  if (!finitePositive(d.totalMass)) {
+    result.status = Status::error("Fabric::fromMesh: total mass must be finite and > 0");
+    return result;
+  }
+  if (!d.uvs.empty() && d.uvs.size() != n) {
+    result.status = Status::error("Fabric::fromMesh: uvs must be empty or one per vertex");
+    return result;
+  }
+  for (const Vec3& p : d.positions) {
+    if (!p.allFinite()) {
+      result.status = Status::error("Fabric::fromMesh: a vertex position is not finite");
+      return result;
+    }
+  }
+  for (std::uint32_t i : d.triangles) {
+    if (i >= n) {
+      result.status = Status::error("Fabric::fromMesh: triangle index " + std::to_string(i) + " out of range");
+      return result;
+    }
+  }
+  std::shared_ptr<Fabric> f(new Fabric());
+  f->restPositions_.resize(static_cast<Eigen::Index>(n), 3);
+  for (std::size_t i = 0; i < n; ++i) f->restPositions_.row(static_cast<Eigen::Index>(i)) = d.positions[i];
+  f->triangles_ = d.triangles;
+  f->uvs_ = d.uvs.empty() ? std::vector<Eigen::Vector2f>(n, Eigen::Vector2f::Zero()) : d.uvs;
+
+  // Lumped masses: each triangle gives a third of its area-share of the mass to each corner.
+  Eigen::VectorXd area = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+  double totalArea = 0.0;
+  // Edges in a sorted map (deterministic order), with the far vertex of each triangle on them.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> edges;
+  for (std::size_t t = 0; t < d.triangles.size(); t += 3) {
+    const std::uint32_t v[3] = {d.triangles[t], d.triangles[t + 1], d.triangles[t + 2]};
+    if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) {
+      result.status = Status::error("Fabric::fromMesh: triangle " + std::to_string(t / 3) + " repeats a vertex");
+      return result;
+    }
+    const double a = 0.5 * (d.positions[v[1]] - d.positions[v[0]])
+                               .cast<double>()
+                               .cross((d.positions[v[2]] - d.positions[v[0]]).cast<double>())
+                               .norm();
+    totalArea += a;
+    for (int k = 0; k < 3; ++k) {
+      area[v[k]] += a / 3.0;
+      std::uint32_t p = v[k], q = v[(k + 1) % 3];
+      if (p > q) std::swap(p, q);
+      edges[{p, q}].push_back(v[(k + 2) % 3]);
+    }
+  }
+  if (!(totalArea > 0.0)) {
+    result.status = Status::error("Fabric::fromMesh: the mesh has zero area");
+    return result;
+  }
+  f->masses_.resize(static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = d.totalMass * area[static_cast<Eigen::Index>(i)] / totalArea;
+    if (!(m > 0.0)) {
+      result.status = Status::error("Fabric::fromMesh: vertex " + std::to_string(i) + " belongs to no triangle of nonzero area");
+      return result;
+    }
+    f->masses_[static_cast<Eigen::Index>(i)] = static_cast<float>(m);
+  }
+  SpringSet& structural = f->springs_[static_cast<int>(SpringFamily::Structural)];
+  SpringSet& bend = f->springs_[static_cast<int>(SpringFamily::Bend)];
+  for (const auto& [edge, far] : edges) {
+    addSpring(structural, edge.first, edge.second);
+    if (d.bendSprings && far.size() == 2 && far[0] != far[1]) addSpring(bend, far[0], far[1]);
+  }
+  result.status = f->finish(d.tetherAnchors, d.tethersPerParticle, d.tetherScale);
+  if (result.status.ok()) result.fabric = std::move(f);
+  return result;
+}
+
+Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale) {
+  const std::size_t n = particleCount();
+  if (springCount() == 0) return Status::error("Fabric: no springs");
+  for (auto& set : springs_) colour(set, n);
+  for (auto& set : springs_) {
+    set.restLength.resize(set.size());
+    for (std::size_t s = 0; s < set.size(); ++s) {
+      const float len = (restPositions_.row(set.first[s]) - restPositions_.row(set.second[s])).norm();
+      if (!(len > 1e-7f)) {
+        return Status::error("Fabric: spring between particles " + std::to_string(set.first[s]) + " and " +
+                             std::to_string(set.second[s]) + " has zero rest length");
+      }
+      set.restLength[s] = len;
+    }
+  }
+  // Rest diameter from the bounding box diagonal: an upper bound on any rest distance.
+  restDiameter_ = (restPositions_.colwise().maxCoeff() - restPositions_.colwise().minCoeff()).norm();
+
+  if (!anchors.empty()) {
+    if (tethersPerParticle < 1) return Status::error("Fabric: tethersPerParticle must be >= 1");
+    if (!(std::isfinite(tetherScale) && tetherScale >= 1.0f)) return Status::error("Fabric: tetherScale must be >= 1");
+    for (std::uint32_t a : anchors)
+      if (a >= n) return Status::error("Fabric: tether anchor " + std::to_string(a) + " out of range");
+    std::vector<std::uint32_t> sortedAnchors = anchors;
+    std::sort(sortedAnchors.begin(), sortedAnchors.end());
+    sortedAnchors.erase(std::unique(sortedAnchors.begin(), sortedAnchors.end()), sortedAnchors.end());
+    const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(tethersPerParticle), sortedAnchors.size());
+    std::vector<std::pair<float, std::uint32_t>> byDistance(sortedAnchors.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (std::binary_search(sortedAnchors.begin(), sortedAnchors.end(), static_cast<std::uint32_t>(i))) continue;
+      for (std::size_t a = 0; a < sortedAnchors.size(); ++a) {
+        byDistance[a] = {(restPositions_.row(static_cast<Eigen::Index>(i)) - restPositions_.row(sortedAnchors[a])).norm(),
+                         sortedAnchors[a]};
+      }
+      std::partial_sort(byDistance.begin(), byDistance.begin() + static_cast<std::ptrdiff_t>(k), byDistance.end());
+      for (std::size_t j = 0; j < k; ++j) {
+        tethers_.particle.push_back(static_cast<std::uint32_t>(i));
+        tethers_.anchor.push_back(byDistance[j].second);
+        tethers_.maxLength.push_back(byDistance[j].first * tetherScale);
+      }
+    }
+  }
+  return Status::success();
+}
+
+}  // namespace cape
