@@ -9,6 +9,7 @@ namespace cape {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kContactPasses = 3;  // extra push-out passes over the substep's contacts
 
 float stiffnessOf(const CapeSettings& s, int family) {
   switch (static_cast<SpringFamily>(family)) {
@@ -64,8 +65,8 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   acceleration_ = Points::Zero(n, 3);
   freeMask_ = Eigen::VectorXf::Ones(n);
   lambda_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric_->springCount()));
-  colliderStart_.reserve(64);
   colliderEnd_.reserve(64);
+  contacts_.reserve(static_cast<std::size_t>(4 * n));
   state_.pins.reserve(static_cast<std::size_t>(n));
 }
 
@@ -176,12 +177,17 @@ void Cape::stepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
   state_.velocities += h * acceleration_;
   state_.positions += h * state_.velocities;
   movePinsTo(s1, h);
+  // Constraints: tethers first (they fix the global stretch in one pass), then the springs, which are left
+  // with only local corrections. Collisions come last, so the cape ends every substep outside the colliders.
   lambda_.setZero();
   for (int it = 0; it < settings_.iterations; ++it) {
-    solveSprings(h);
     if (settings_.useTethers) solveTethers();
+    solveSprings(h);
   }
   collide(h, s0, s1, colliders, false);
+  // A particle wedged where two colliders meet (a shoulder sphere poking out of the torso box) is pushed out
+  // of one into the other; a few Gauss-Seidel passes over the contacts settle it outside both.
+  for (int pass = 0; pass < kContactPasses; ++pass) reprojectContacts(colliders);
   // New velocities from the position change, then damping: dv/dt = -c v integrated implicitly
   // (v <- v / (1 + c h), the Padé approximation of exp(-c h), unconditionally stable).
   const float scale = 1.0f / (h * (1.0f + settings_.damping * h));
@@ -292,6 +298,7 @@ void Cape::stepExplicit(float h, float s0, float s1, ColliderSpan colliders) {
   state_.positions += h * state_.velocities;
   movePinsTo(s1, h);
   collide(h, s0, s1, colliders, true);
+  for (int pass = 0; pass < kContactPasses; ++pass) reprojectContacts(colliders);
 }
 
 double Cape::energy() const {

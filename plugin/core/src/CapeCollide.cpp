@@ -34,13 +34,15 @@ struct ParticleArrays {
   float* vy;
   float* vz;
   Eigen::Index n;
+  std::vector<Cape::Contact>* contacts;
+  std::uint32_t collider;
 };
 
 /// One collider against every free particle. In the collider's own frame the collider is still and the
 /// particle moves from a (its start, in the frame's pose at s0) to b (its prediction, in the pose at s1):
 /// relative motion, so a fast collider and a fast particle are the same problem.
 template <ColliderShape S>
-void collideWith(const Collider& c, const ParticleArrays& p, float s0, float s1, float margin, float mu,
+__attribute__((flatten)) void collideWith(const Collider& c, const ParticleArrays& p, float s0, float s1, float margin, float mu,
                  float invH, bool explicitMode) {
   using detail::shapeDistance;
   const Pose A = Pose::interpolate(c.previous, c.current, s0);
@@ -67,10 +69,10 @@ void collideWith(const Collider& c, const ParticleArrays& p, float s0, float s1,
       if (relNorm > bound + margin + sweep) continue;  // cannot touch in this substep
     }
     const Vec3 b = invRB * rel;
-    const SurfaceDistance sb = shapeDistance<S>(c, b);
     // The signed distance is 1-Lipschitz: if the end is farther than the whole relative motion, the segment
     // never came within the margin.
-    if (sb.distance >= margin + sweep) continue;
+    if (detail::shapeDistanceOnly<S>(c, b) >= margin + sweep) continue;
+    const SurfaceDistance sb = shapeDistance<S>(c, b);
     const Vec3 a = invRA * (x0 - A.position);
     const SurfaceDistance sa = shapeDistance<S>(c, a);
     Vec3 bn = b;
@@ -78,9 +80,11 @@ void collideWith(const Collider& c, const ParticleArrays& p, float s0, float s1,
     bool touched = false;
     const Vec3 ab = b - a;
     const float len = ab.norm();
-    // Both ends clear, but the motion is long enough to tunnel through a thin part (along the segment
-    // d >= (d(a) + d(b) - len) / 2): conservative advancement from a finds the first contact.
-    if (sa.distance >= margin && sb.distance >= margin && sa.distance + sb.distance - len < 2.0f * margin) {
+    // Started clear and either ended inside the skin or moved far enough to tunnel through a thin part
+    // (along the segment d >= (d(a) + d(b) - len) / 2): conservative advancement from a finds the first
+    // contact, and the particle leaves through the face it came in by — not through whichever face is
+    // nearest to where it ended, which near a box's edge would tear neighbouring particles apart.
+    if (sa.distance >= margin && sa.distance + sb.distance - len < 2.0f * margin) {
       float t = 0.0f;
       SurfaceDistance s = sa;
       bool hit = false;
@@ -134,7 +138,22 @@ void collideWith(const Collider& c, const ParticleArrays& p, float s0, float s1,
     p.px[i] = xn.x();
     p.py[i] = xn.y();
     p.pz[i] = xn.z();
+    p.contacts->push_back({static_cast<std::uint32_t>(i), p.collider});
   }
+}
+
+/// Pushes the contact's particle back out of its collider (pose at the substep's end) if the constraint
+/// solve moved it into the skin.
+template <ColliderShape S>
+void reproject(const Collider& c, const Pose& B, float margin, float* px, float* py, float* pz, std::uint32_t i) {
+  const Vec3 x(px[i], py[i], pz[i]);
+  const Vec3 b = B.applyInverse(x);
+  const SurfaceDistance s = detail::shapeDistance<S>(c, b);
+  if (s.distance >= margin) return;
+  const Vec3 xn = B.apply(b + (margin - s.distance) * s.normal);
+  px[i] = xn.x();
+  py[i] = xn.y();
+  pz[i] = xn.z();
 }
 
 }  // namespace
@@ -143,9 +162,13 @@ void Cape::collide(float h, float s0, float s1, ColliderSpan colliders, bool exp
   ParticleArrays p{state_.positions.col(0).data(),  state_.positions.col(1).data(),  state_.positions.col(2).data(),
                    startPositions_.col(0).data(),   startPositions_.col(1).data(),   startPositions_.col(2).data(),
                    state_.inverseMasses.data(),     state_.velocities.col(0).data(), state_.velocities.col(1).data(),
-                   state_.velocities.col(2).data(), state_.positions.rows()};
+                   state_.velocities.col(2).data(), state_.positions.rows(), &contacts_, 0};
   const float invH = 1.0f / h;
+  contacts_.clear();
+  colliderEnd_.clear();
   for (const Collider& c : colliders) {
+    colliderEnd_.push_back(Pose::interpolate(c.previous, c.current, s1));
+    p.collider = static_cast<std::uint32_t>(colliderEnd_.size() - 1);
     if (!c.validate().ok()) continue;  // documented: an invalid collider (NaN pose, bad size) is skipped
     const float margin = settings_.collisionThickness + c.thickness;
     const float mu = c.friction >= 0.0f ? c.friction : settings_.friction;
@@ -155,6 +178,24 @@ void Cape::collide(float h, float s0, float s1, ColliderSpan colliders, bool exp
       case ColliderShape::Cylinder: collideWith<ColliderShape::Cylinder>(c, p, s0, s1, margin, mu, invH, explicitMode); break;
       case ColliderShape::Box: collideWith<ColliderShape::Box>(c, p, s0, s1, margin, mu, invH, explicitMode); break;
       case ColliderShape::Plane: collideWith<ColliderShape::Plane>(c, p, s0, s1, margin, mu, invH, explicitMode); break;
+    }
+  }
+}
+
+void Cape::reprojectContacts(ColliderSpan colliders) {
+  float* px = state_.positions.col(0).data();
+  float* py = state_.positions.col(1).data();
+  float* pz = state_.positions.col(2).data();
+  for (const Contact& k : contacts_) {
+    const Collider& c = colliders.data[k.collider];
+    const Pose& B = colliderEnd_[k.collider];
+    const float margin = settings_.collisionThickness + c.thickness;
+    switch (c.shape) {
+      case ColliderShape::Sphere: reproject<ColliderShape::Sphere>(c, B, margin, px, py, pz, k.particle); break;
+      case ColliderShape::Capsule: reproject<ColliderShape::Capsule>(c, B, margin, px, py, pz, k.particle); break;
+      case ColliderShape::Cylinder: reproject<ColliderShape::Cylinder>(c, B, margin, px, py, pz, k.particle); break;
+      case ColliderShape::Box: reproject<ColliderShape::Box>(c, B, margin, px, py, pz, k.particle); break;
+      case ColliderShape::Plane: reproject<ColliderShape::Plane>(c, B, margin, px, py, pz, k.particle); break;
     }
   }
 }

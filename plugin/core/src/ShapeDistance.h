@@ -74,4 +74,21 @@ inline SurfaceDistance shapeDistance(const Collider& c, const Vec3& p) {
   }
 }
 
+/// The signed distance alone (no normal: no division), for the cheap rejection test.
+template <ColliderShape S>
+inline float shapeDistanceOnly(const Collider& c, const Vec3& p) {
+  if constexpr (S == ColliderShape::Sphere) {
+    return p.norm() - c.radius;
+  } else if constexpr (S == ColliderShape::Capsule) {
+    Vec3 off = p;
+    off[c.axis] -= std::clamp(p[c.axis], -c.halfHeight, c.halfHeight);
+    return off.norm() - c.radius;
+  } else if constexpr (S == ColliderShape::Box) {
+    const Vec3 q = p.cwiseAbs() - c.halfExtents;
+    return q.maxCoeff() <= 0.0f ? q.maxCoeff() : q.cwiseMax(0.0f).norm();
+  } else {
+    return shapeDistance<S>(c, p).distance;
+  }
+}
+
 }  // namespace cape::detail

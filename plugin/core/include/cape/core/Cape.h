@@ -57,6 +57,12 @@ class Cape {
   /// from their previous to their current pose. Non-finite or non-positive dt is ignored.
   void step(float dt, ColliderSpan colliders);
 
+  /// A particle that touched a collider in this substep's collision pass (index into the step's colliders).
+  struct Contact {
+    std::uint32_t particle;
+    std::uint32_t collider;
+  };
+
   /// Sum over particles of kinetic and gravitational potential energy plus spring (Hooke) energy, J.
   double energy() const;
 
@@ -65,6 +71,7 @@ class Cape {
   void stepExplicit(float h, float s0, float s1, ColliderSpan colliders);
   void movePinsTo(float s, float h);
   void collide(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode);
+  void reprojectContacts(ColliderSpan colliders);
   void solveSprings(float h);
   void solveTethers();
   void accumulateExternalAcceleration(float t);
@@ -80,8 +87,8 @@ class Cape {
   Eigen::VectorXf freeMask_;     ///< 1 for free particles, 0 for pinned, refreshed each step.
   Eigen::VectorXf lambda_;       ///< XPBD Lagrange multipliers of every spring, per substep.
   std::vector<float> familyCompliance_;
-  std::vector<Pose> colliderStart_;  ///< Scratch: collider poses at the substep's ends.
-  std::vector<Pose> colliderEnd_;
+  std::vector<Pose> colliderEnd_;   ///< Collider poses at the end of the substep.
+  std::vector<Contact> contacts_;   ///< Contacts of the substep's collision pass.
 };
 
 }  // namespace cape
