@@ -67,6 +67,8 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   lambda_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric_->springCount()));
   colliderEnd_.reserve(64);
   contacts_.reserve(static_cast<std::size_t>(4 * n));
+  distance2_.resize(n);
+  candidates_.reserve(static_cast<std::size_t>(n));
   state_.pins.reserve(static_cast<std::size_t>(n));
 }
 
@@ -197,6 +199,41 @@ void Cape::stepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
   }
 }
 
+namespace {
+
+/// XPBD distance constraints C = |xj - xi| - L with compliance alpha (Macklin et al. 2016):
+///   dlambda = (-C - alpha~ lambda) / (wi + wj + alpha~),  alpha~ = alpha / h^2,
+///   xi -= wi dlambda n,  xj += wj dlambda n,  n = (xj - xi) / |xj - xi|.
+/// Springs [begin, end) share no particle (one colour), so consecutive iterations do not wait on each other's
+/// stores and the processor overlaps their square roots and divisions. (Measured: explicit 8-lane SIMD
+/// batches with gathers and scatters were 15 % slower than this scalar loop at N = 20.)
+void solveSpringColour(float* __restrict px, float* __restrict py, float* __restrict pz, const float* __restrict w,
+                       const std::uint32_t* __restrict first, const std::uint32_t* __restrict second,
+                       const float* __restrict rest, float* __restrict lambda, std::size_t begin, std::size_t end,
+                       float alpha) {
+  for (std::size_t s = begin; s < end; ++s) {
+    const std::uint32_t i = first[s], j = second[s];
+    const float wi = w[i], wj = w[j];
+    const float wsum = wi + wj;
+    const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
+    const float len2 = dx * dx + dy * dy + dz * dz;
+    if (!(wsum > 0.0f && len2 > 1e-18f)) continue;  // both ends pinned, or zero length: no direction
+    const float len = std::sqrt(len2);
+    const float dl = (rest[s] - len - alpha * lambda[s]) / (wsum + alpha);
+    lambda[s] += dl;
+    const float k = dl / len;
+    const float cx = k * dx, cy = k * dy, cz = k * dz;
+    px[i] -= wi * cx;
+    py[i] -= wi * cy;
+    pz[i] -= wi * cz;
+    px[j] += wj * cx;
+    py[j] += wj * cy;
+    pz[j] += wj * cz;
+  }
+}
+
+}  // namespace
+
 void Cape::solveSprings(float h) {
   float* px = state_.positions.col(0).data();
   float* py = state_.positions.col(1).data();
@@ -207,58 +244,40 @@ void Cape::solveSprings(float h) {
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
     const float compliance = familyCompliance_[static_cast<std::size_t>(f)];
-    if (std::isinf(compliance)) {
-      lambda += set.size();
-      continue;
+    if (!std::isinf(compliance)) {
+      const float alpha = compliance * invH2;
+      for (std::size_t c = 0; c < set.colourCount(); ++c) {
+        solveSpringColour(px, py, pz, w, set.first.data(), set.second.data(), set.restLength.data(), lambda,
+                          set.colourStart[c], set.colourStart[c + 1], alpha);
+      }
     }
-    // XPBD distance constraint C = |xj - xi| - L with compliance alpha (Macklin et al. 2016):
-    //   dlambda = (-C - alpha~ lambda) / (wi + wj + alpha~),  alpha~ = alpha / h^2,
-    //   xi -= wi dlambda n,  xj += wj dlambda n,  n = (xj - xi) / |xj - xi|.
-    const float alpha = compliance * invH2;
-    const std::uint32_t* first = set.first.data();
-    const std::uint32_t* second = set.second.data();
-    const float* rest = set.restLength.data();
-    const std::size_t count = set.size();
-    for (std::size_t s = 0; s < count; ++s) {
-      const std::uint32_t i = first[s], j = second[s];
-      const float wsum = w[i] + w[j];
-      if (wsum <= 0.0f) continue;
-      const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
-      const float len2 = dx * dx + dy * dy + dz * dz;
-      if (len2 < 1e-18f) continue;
-      const float len = std::sqrt(len2);
-      const float dl = (rest[s] - len - alpha * lambda[s]) / (wsum + alpha);
-      lambda[s] += dl;
-      const float k = dl / len;
-      const float cx = k * dx, cy = k * dy, cz = k * dz;
-      px[i] -= w[i] * cx;
-      py[i] -= w[i] * cy;
-      pz[i] -= w[i] * cz;
-      px[j] += w[j] * cx;
-      py[j] += w[j] * cy;
-      pz[j] += w[j] * cz;
-    }
-    lambda += count;
+    lambda += set.size();
   }
 }
 
 void Cape::solveTethers() {
+  // Unilateral: |x_p - x_a| <= maxLength while the anchor a is pinned (w_a = 0), so only p moves, straight
+  // towards the anchor. The fabric orders tethers so that consecutive ones belong to different particles, and
+  // the update is a select rather than a branch (whether a tether is taut is close to random from one to
+  // the next, and mispredicted branches cost more than the square root).
   const TetherSet& t = fabric_->tethers();
-  float* px = state_.positions.col(0).data();
-  float* py = state_.positions.col(1).data();
-  float* pz = state_.positions.col(2).data();
-  const float* w = state_.inverseMasses.data();
+  float* __restrict px = state_.positions.col(0).data();
+  float* __restrict py = state_.positions.col(1).data();
+  float* __restrict pz = state_.positions.col(2).data();
+  const float* __restrict w = state_.inverseMasses.data();
+  const std::uint32_t* __restrict particle = t.particle.data();
+  const std::uint32_t* __restrict anchor = t.anchor.data();
+  const float* __restrict maxLength = t.maxLength.data();
   for (std::size_t k = 0; k < t.size(); ++k) {
-    const std::uint32_t a = t.anchor[k], p = t.particle[k];
-    if (w[a] != 0.0f || w[p] == 0.0f) continue;  // only while the anchor is pinned
+    const std::uint32_t a = anchor[k], p = particle[k];
     const float dx = px[p] - px[a], dy = py[p] - py[a], dz = pz[p] - pz[a];
     const float len2 = dx * dx + dy * dy + dz * dz;
-    const float maxLen = t.maxLength[k];
-    if (len2 <= maxLen * maxLen) continue;
-    const float scale = maxLen / std::sqrt(len2);
-    px[p] = px[a] + dx * scale;
-    py[p] = py[a] + dy * scale;
-    pz[p] = pz[a] + dz * scale;
+    const float maxLen = maxLength[k];
+    const bool taut = w[a] == 0.0f && w[p] != 0.0f && len2 > maxLen * maxLen;
+    const float scale = maxLen / std::sqrt(std::max(len2, 1e-30f));
+    px[p] = taut ? px[a] + dx * scale : px[p];
+    py[p] = taut ? py[a] + dy * scale : py[p];
+    pz[p] = taut ? pz[a] + dz * scale : pz[p];
   }
 }
 

@@ -36,6 +36,9 @@ struct ParticleArrays {
   Eigen::Index n;
   std::vector<Cape::Contact>* contacts;
   std::uint32_t collider;
+  float maxTravel;                        ///< the largest distance any particle moved in this substep, m
+  Eigen::ArrayXf* distance2;              ///< scratch, one per particle
+  std::vector<std::uint32_t>* candidates; ///< scratch
 };
 
 /// One collider against every free particle. In the collider's own frame the collider is still and the
@@ -54,8 +57,31 @@ __attribute__((flatten)) void collideWith(const Collider& c, const ParticleArray
   const float shift = (B.position - A.position).norm();
   const float turn = A.rotation.angularDistance(B.rotation);  // rad over the substep
 
-  for (Eigen::Index i = 0; i < p.n; ++i) {
-    if (p.w[i] == 0.0f) continue;
+  // Broad phase, vectorised over all particles: only particles that could reach the collider's bounding
+  // sphere (or the plane) within this substep go on to the exact test.
+  Eigen::Map<const Eigen::ArrayXf> X(p.px, p.n), Y(p.py, p.n), Z(p.pz, p.n);
+  Eigen::ArrayXf& d2 = *p.distance2;
+  float reach = std::numeric_limits<float>::infinity();
+  if constexpr (S == ColliderShape::Plane) {
+    const Vec3 nw = B.rotation * c.normal;
+    const float cw = c.constant + nw.dot(B.position);
+    d2 = X * nw.x() + Y * nw.y() + Z * nw.z() - cw;  // signed distance to the plane at s1
+    reach = turn > 0.0f ? std::numeric_limits<float>::infinity() : margin + shift + p.maxTravel;
+  } else {
+    d2 = (X - B.position.x()).square() + (Y - B.position.y()).square() + (Z - B.position.z()).square();
+    // A particle at distance r from the origin moves at most travel + shift + turn (r + travel) relative to
+    // the collider; it can touch only if r <= bound + margin + that, i.e. r <= reach below.
+    if (turn < 0.5f) {
+      const float r = (bound + margin + shift + p.maxTravel * (1.0f + turn)) / (1.0f - turn);
+      reach = r * r;
+    }
+  }
+  std::vector<std::uint32_t>& candidates = *p.candidates;
+  candidates.clear();
+  for (Eigen::Index i = 0; i < p.n; ++i)
+    if (d2[i] <= reach && p.w[i] != 0.0f) candidates.push_back(static_cast<std::uint32_t>(i));
+
+  for (const std::uint32_t i : candidates) {
     const Vec3 x(p.px[i], p.py[i], p.pz[i]);
     const Vec3 x0(p.sx[i], p.sy[i], p.sz[i]);
     const Vec3 rel = x - B.position;
@@ -138,7 +164,7 @@ __attribute__((flatten)) void collideWith(const Collider& c, const ParticleArray
     p.px[i] = xn.x();
     p.py[i] = xn.y();
     p.pz[i] = xn.z();
-    p.contacts->push_back({static_cast<std::uint32_t>(i), p.collider});
+    p.contacts->push_back({i, p.collider});
   }
 }
 
@@ -162,7 +188,9 @@ void Cape::collide(float h, float s0, float s1, ColliderSpan colliders, bool exp
   ParticleArrays p{state_.positions.col(0).data(),  state_.positions.col(1).data(),  state_.positions.col(2).data(),
                    startPositions_.col(0).data(),   startPositions_.col(1).data(),   startPositions_.col(2).data(),
                    state_.inverseMasses.data(),     state_.velocities.col(0).data(), state_.velocities.col(1).data(),
-                   state_.velocities.col(2).data(), state_.positions.rows(), &contacts_, 0};
+                   state_.velocities.col(2).data(), state_.positions.rows(), &contacts_, 0, 0.0f,
+                   &distance2_, &candidates_};
+  p.maxTravel = std::sqrt((state_.positions - startPositions_).rowwise().squaredNorm().maxCoeff());
   const float invH = 1.0f / h;
   contacts_.clear();
   colliderEnd_.clear();

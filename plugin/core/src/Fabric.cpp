@@ -244,6 +244,7 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
     sortedAnchors.erase(std::unique(sortedAnchors.begin(), sortedAnchors.end()), sortedAnchors.end());
     const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(tethersPerParticle), sortedAnchors.size());
     std::vector<std::pair<float, std::uint32_t>> byDistance(sortedAnchors.size());
+    std::vector<std::vector<std::pair<std::uint32_t, std::pair<float, std::uint32_t>>>> nearest(k);
     for (std::size_t i = 0; i < n; ++i) {
       if (std::binary_search(sortedAnchors.begin(), sortedAnchors.end(), static_cast<std::uint32_t>(i))) continue;
       for (std::size_t a = 0; a < sortedAnchors.size(); ++a) {
@@ -251,10 +252,15 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
                          sortedAnchors[a]};
       }
       std::partial_sort(byDistance.begin(), byDistance.begin() + static_cast<std::ptrdiff_t>(k), byDistance.end());
-      for (std::size_t j = 0; j < k; ++j) {
-        tethers_.particle.push_back(static_cast<std::uint32_t>(i));
-        tethers_.anchor.push_back(byDistance[j].second);
-        tethers_.maxLength.push_back(byDistance[j].first * tetherScale);
+      for (std::size_t j = 0; j < k; ++j) nearest[j].push_back({static_cast<std::uint32_t>(i), byDistance[j]});
+    }
+    // Nearest anchors of every particle first, then the second nearest...: consecutive tethers then belong to
+    // different particles and do not wait on each other in the solver.
+    for (const auto& rank : nearest) {
+      for (const auto& [particle, anchor] : rank) {
+        tethers_.particle.push_back(particle);
+        tethers_.anchor.push_back(anchor.second);
+        tethers_.maxLength.push_back(anchor.first * tetherScale);
       }
     }
   }

@@ -89,6 +89,8 @@ class Cape {
   std::vector<float> familyCompliance_;
   std::vector<Pose> colliderEnd_;   ///< Collider poses at the end of the substep.
   std::vector<Contact> contacts_;   ///< Contacts of the substep's collision pass.
+  Eigen::ArrayXf distance2_;        ///< Broad-phase scratch, one per particle.
+  std::vector<std::uint32_t> candidates_;  ///< Broad-phase scratch.
 };
 
 }  // namespace cape
