@@ -31,6 +31,11 @@ void runFrames(benchmark::State& state, SceneKind kind, const CapeSettings& sett
 }
 
 void BM_WalkFrame(benchmark::State& state) { runFrames(state, SceneKind::Walk, CapeSettings()); }
+void BM_WalkFrame4Substeps(benchmark::State& state) {
+  CapeSettings s;
+  s.substeps = 4;
+  runFrames(state, SceneKind::Walk, s);
+}
 void BM_SprintTurnFrame(benchmark::State& state) { runFrames(state, SceneKind::SprintTurn, CapeSettings()); }
 void BM_WalkFrameSeedExplicit(benchmark::State& state) {
   CapeSettings s = CapeSettings::seed();
@@ -42,6 +47,7 @@ void BM_WalkFrameSeedExplicit(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_WalkFrame)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WalkFrame4Substeps)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SprintTurnFrame)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrameSeedExplicit)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK_MAIN();

@@ -65,6 +65,7 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   acceleration_ = Points::Zero(n, 3);
   freeMask_ = Eigen::VectorXf::Ones(n);
   lambda_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric_->springCount()));
+  invDenominator_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric_->springCount()));
   colliderEnd_.reserve(64);
   contacts_.reserve(static_cast<std::size_t>(4 * n));
   distance2_.resize(n);
@@ -145,6 +146,7 @@ void Cape::step(float dt, ColliderSpan colliders) {
   const float h = dt / static_cast<float>(substeps);
   // 1 for free particles, 0 for pinned ones (same size every step: no allocation).
   freeMask_ = (state_.inverseMasses.array() > 0.0f).cast<float>();
+  if (settings_.integrator == Integrator::Xpbd) prepareSpringDenominators(h);
   for (int k = 0; k < substeps; ++k) {
     const float s0 = static_cast<float>(k) / static_cast<float>(substeps);
     const float s1 = static_cast<float>(k + 1) / static_cast<float>(substeps);
@@ -209,17 +211,17 @@ namespace {
 /// batches with gathers and scatters were 15 % slower than this scalar loop at N = 20.)
 void solveSpringColour(float* __restrict px, float* __restrict py, float* __restrict pz, const float* __restrict w,
                        const std::uint32_t* __restrict first, const std::uint32_t* __restrict second,
-                       const float* __restrict rest, float* __restrict lambda, std::size_t begin, std::size_t end,
-                       float alpha) {
+                       const float* __restrict rest, const float* __restrict invDenominator,
+                       float* __restrict lambda, std::size_t begin, std::size_t end, float alpha) {
   for (std::size_t s = begin; s < end; ++s) {
     const std::uint32_t i = first[s], j = second[s];
     const float wi = w[i], wj = w[j];
-    const float wsum = wi + wj;
     const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
     const float len2 = dx * dx + dy * dy + dz * dz;
-    if (!(wsum > 0.0f && len2 > 1e-18f)) continue;  // both ends pinned, or zero length: no direction
+    // invDenominator is 0 when both ends are pinned; a zero length has no direction.
+    if (!(len2 > 1e-18f)) continue;
     const float len = std::sqrt(len2);
-    const float dl = (rest[s] - len - alpha * lambda[s]) / (wsum + alpha);
+    const float dl = (rest[s] - len - alpha * lambda[s]) * invDenominator[s];
     lambda[s] += dl;
     const float k = dl / len;
     const float cx = k * dx, cy = k * dy, cz = k * dz;
@@ -234,12 +236,31 @@ void solveSpringColour(float* __restrict px, float* __restrict py, float* __rest
 
 }  // namespace
 
+void Cape::prepareSpringDenominators(float h) {
+  // 1 / (w_i + w_j + alpha / h^2) of every spring: constant over the step's substeps, so the solver loop
+  // multiplies instead of dividing. 0 when both ends are pinned (no correction).
+  const float invH2 = 1.0f / (h * h);
+  const float* w = state_.inverseMasses.data();
+  float* out = invDenominator_.data();
+  for (int f = 0; f < kSpringFamilyCount; ++f) {
+    const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
+    const float compliance = familyCompliance_[static_cast<std::size_t>(f)];
+    const float alpha = std::isinf(compliance) ? 0.0f : compliance * invH2;
+    for (std::size_t s = 0; s < set.size(); ++s) {
+      const float wsum = w[set.first[s]] + w[set.second[s]];
+      out[s] = wsum > 0.0f ? 1.0f / (wsum + alpha) : 0.0f;
+    }
+    out += set.size();
+  }
+}
+
 void Cape::solveSprings(float h) {
   float* px = state_.positions.col(0).data();
   float* py = state_.positions.col(1).data();
   float* pz = state_.positions.col(2).data();
   const float* w = state_.inverseMasses.data();
   float* lambda = lambda_.data();
+  const float* invDenominator = invDenominator_.data();
   const float invH2 = 1.0f / (h * h);
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
@@ -247,11 +268,12 @@ void Cape::solveSprings(float h) {
     if (!std::isinf(compliance)) {
       const float alpha = compliance * invH2;
       for (std::size_t c = 0; c < set.colourCount(); ++c) {
-        solveSpringColour(px, py, pz, w, set.first.data(), set.second.data(), set.restLength.data(), lambda,
-                          set.colourStart[c], set.colourStart[c + 1], alpha);
+        solveSpringColour(px, py, pz, w, set.first.data(), set.second.data(), set.restLength.data(), invDenominator,
+                          lambda, set.colourStart[c], set.colourStart[c + 1], alpha);
       }
     }
     lambda += set.size();
+    invDenominator += set.size();
   }
 }
 

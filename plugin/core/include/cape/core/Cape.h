@@ -72,6 +72,7 @@ class Cape {
   void movePinsTo(float s, float h);
   void collide(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode);
   void reprojectContacts(ColliderSpan colliders);
+  void prepareSpringDenominators(float h);
   void solveSprings(float h);
   void solveTethers();
   void accumulateExternalAcceleration(float t);
@@ -86,6 +87,7 @@ class Cape {
   Points acceleration_;          ///< External acceleration per particle (gravity + wind), m/s^2.
   Eigen::VectorXf freeMask_;     ///< 1 for free particles, 0 for pinned, refreshed each step.
   Eigen::VectorXf lambda_;       ///< XPBD Lagrange multipliers of every spring, per substep.
+  Eigen::VectorXf invDenominator_;  ///< 1 / (w_i + w_j + alpha~) of every spring, per step.
   std::vector<float> familyCompliance_;
   std::vector<Pose> colliderEnd_;   ///< Collider poses at the end of the substep.
   std::vector<Contact> contacts_;   ///< Contacts of the substep's collision pass.
