@@ -1,0 +1,157 @@
+#include "RunOutput.h"
+
+#include <cstdio>
+#include <ctime>
+#include <stdexcept>
+
+namespace cape::demo {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+const char* axisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
+}  // namespace
+
+json colliderJson(const Collider& c) {
+  json j;
+  j["name"] = c.name;
+  j["type"] = toString(c.shape);
+  const Pose& p = c.current;
+  j["position"] = vec(p.position);
+  j["rotation"] = json::array({p.rotation.x(), p.rotation.y(), p.rotation.z(), p.rotation.w()});
+  switch (c.shape) {
+    case ColliderShape::Sphere:
+      j["radius"] = c.radius;
+      break;
+    case ColliderShape::Capsule:
+    case ColliderShape::Cylinder:
+      j["radius"] = c.radius;
+      j["half_height"] = c.halfHeight;
+      j["axis"] = axisName(c.axis);
+      break;
+    case ColliderShape::Box:
+      j["half_extents"] = vec(c.halfExtents);
+      break;
+    case ColliderShape::Plane: {
+      // World plane n . x = constant, solid below.
+      const Vec3 n = p.rotation * c.normal;
+      j["normal"] = vec(n);
+      j["constant"] = c.constant + n.dot(p.position);
+      break;
+    }
+  }
+  if (c.thickness > 0.0f) j["thickness"] = c.thickness;
+  return j;
+}
+
+void writeObj(const fs::path& file, const CapeMesh& mesh, std::size_t n) {
+  std::FILE* f = std::fopen(file.c_str(), "w");
+  if (!f) throw std::runtime_error("cannot write " + file.string());
+  std::fprintf(f, "# cape mesh: %zu vertices in particle order (row-major from the top-left for grids)\n", n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto r = mesh.positions.row(static_cast<Eigen::Index>(i));
+    std::fprintf(f, "v %.6f %.6f %.6f\n", r.x(), r.y(), r.z());
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto r = mesh.normals.row(static_cast<Eigen::Index>(i));
+    std::fprintf(f, "vn %.5f %.5f %.5f\n", r.x(), r.y(), r.z());
+  }
+  for (std::size_t i = 0; i < n; ++i) std::fprintf(f, "vt %.6f %.6f\n", mesh.uvs[i].x(), 1.0f - mesh.uvs[i].y());
+  for (std::size_t t = 0; t + 2 < mesh.indices.size() && mesh.indices[t] < n; t += 3) {
+    const unsigned a = mesh.indices[t] + 1, b = mesh.indices[t + 1] + 1, c = mesh.indices[t + 2] + 1;
+    std::fprintf(f, "f %u/%u/%u %u/%u/%u %u/%u/%u\n", a, a, a, b, b, b, c, c, c);
+  }
+  std::fclose(f);
+}
+
+RunWriter::RunWriter(const fs::path& dir, bool writeFrames, int characters)
+    : dir_(dir), writeFrames_(writeFrames), characters_(characters) {
+  std::error_code ec;
+  fs::create_directories(dir_, ec);
+  if (ec) throw std::runtime_error("cannot create output folder " + dir_.string() + ": " + ec.message());
+  if (writeFrames_) {
+    if (characters_ > 1) {
+      for (int k = 0; k < characters_; ++k) fs::create_directories(dir_ / "frames" / ("k" + std::to_string(k)), ec);
+    } else {
+      fs::create_directories(dir_ / "frames", ec);
+    }
+    if (ec) throw std::runtime_error("cannot create " + (dir_ / "frames").string() + ": " + ec.message());
+  }
+  csv_.open(dir_ / "metrics.csv");
+  jsonl_.open(dir_ / "colliders.jsonl");
+  if (!csv_ || !jsonl_) throw std::runtime_error("cannot write into " + dir_.string());
+  csv_ << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_intersections,"
+          "pin_error_m,mean_speed_mps,blow_up\n";
+}
+
+void RunWriter::frame(const FrameRow& r) {
+  char line[512];
+  std::snprintf(line, sizeof line, "%d,%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%.5f,%d\n", r.frame, r.time, r.frameTimeUs,
+                r.capeTimeUs, r.metrics.maxStrain, r.metrics.meanStrain, r.metrics.maxPenetration,
+                r.metrics.selfIntersections, r.metrics.pinError, r.metrics.meanSpeed, r.metrics.blowUp ? 1 : 0);
+  csv_ << line;
+}
+
+void RunWriter::capeMesh(int frame, int character, const Cape& cape) {
+  if (!writeFrames_) return;
+  if (mesh_.positions.rows() != static_cast<Eigen::Index>(cape.fabric().particleCount())) mesh_.allocate(cape.fabric(), false);
+  mesh_.update(cape.fabric(), cape.state().positions);
+  char name[32];
+  std::snprintf(name, sizeof name, "%05d.obj", frame);
+  const fs::path folder = characters_ > 1 ? dir_ / "frames" / ("k" + std::to_string(character)) : dir_ / "frames";
+  writeObj(folder / name, mesh_, cape.fabric().particleCount());
+}
+
+void RunWriter::colliders(int frame, const std::vector<Collider>& colliders) {
+  json j;
+  j["frame"] = frame;
+  j["colliders"] = json::array();
+  for (const Collider& c : colliders) j["colliders"].push_back(colliderJson(c));
+  jsonl_ << j.dump() << '\n';
+}
+
+void RunWriter::summary(const json& s) {
+  std::ofstream out(dir_ / "summary.json");
+  out << s.dump(2) << '\n';
+  if (!out) throw std::runtime_error("cannot write " + (dir_ / "summary.json").string());
+}
+
+json summaryFigures(const std::vector<FrameRow>& rows, const RunSummary& q) {
+  std::vector<double> frameTimes, capeTimes;
+  for (std::size_t i = 10; i < rows.size(); ++i) {  // frames 11..end
+    frameTimes.push_back(rows[i].frameTimeUs);
+    capeTimes.push_back(rows[i].capeTimeUs);
+  }
+  json j;
+  j["frames"] = q.frames;
+  j["frame_time_us_median"] = percentile(frameTimes, 50.0);
+  j["frame_time_us_p95"] = percentile(frameTimes, 95.0);
+  j["cape_time_us_median"] = percentile(capeTimes, 50.0);
+  j["cape_time_us_p95"] = percentile(capeTimes, 95.0);
+  j["max_strain"] = q.maxStrain;
+  j["mean_strain"] = q.meanStrain;
+  j["median_frame_max_strain"] = q.medianFrameMaxStrain;
+  j["p95_frame_max_strain"] = q.p95FrameMaxStrain;
+  j["max_penetration_m"] = q.maxPenetration;
+  j["frames_penetration_over_1mm"] = q.framesPenetrationOver1mm;
+  j["self_intersections_max"] = q.selfIntersectionsMax;
+  j["frames_with_self_intersections"] = q.framesWithSelfIntersections;
+  j["pin_error_max_m"] = q.pinErrorMax;
+  j["rest_jitter_mps"] = q.restJitter;
+  j["blow_up"] = q.blowUp;
+  return j;
+}
+
+fs::path freshRunFolder(const std::string& scene) {
+  char stamp[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
+  fs::path base = "cape_run_" + scene + "_" + stamp;
+  fs::path dir = base;
+  for (int k = 2; fs::exists(dir); ++k) dir = base.string() + "-" + std::to_string(k);
+  return dir;
+}
+
+}  // namespace cape::demo

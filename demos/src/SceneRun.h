@@ -1,0 +1,55 @@
+// A scene as the demos run it: one or more characters, each with a cape, advanced one 1/60 s frame at a time.
+// Two kinds: the simple body of SCENARIOS.md driven by the core alone, and a URDF character in a Bullet
+// world with the cape attached through the Bullet adapter.
+#pragma once
+
+#include "cape/core/Metrics.h"
+#include "cape/core/Scene.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace cape::demo {
+
+/// What every run is asked for; each kind uses what applies to it.
+struct RunOptions {
+  SceneKind scene = SceneKind::Walk;
+  int size = 20;  ///< particles per side
+  Attachment attachment = Attachment::Corners;
+  double seconds = -1.0;  ///< < 0: the scene's own length
+  int characters = 1;     ///< crowd size
+  int threads = 1;
+  CapeSettings settings;
+  bool simpleBody = false;
+  std::string urdf;                   ///< empty: the shipped humanoid
+  std::vector<std::string> attachLinks;  ///< empty: found by name ("shoulder")
+};
+
+class SceneRun {
+ public:
+  virtual ~SceneRun() = default;
+  virtual int characterCount() const = 0;
+  /// Advances one frame of 1/60 s.
+  virtual void advanceFrame() = 0;
+  virtual const Cape& cape(int character) const = 0;
+  /// Body colliders of a character at the current frame (ground excluded), for metrics and colliders.jsonl.
+  virtual std::vector<Collider> bodyColliders(int character) const = 0;
+  virtual Vec3 torsoCentre(int character) const = 0;
+  /// Wall time of the last frame, and the cape solver's share of it, µs.
+  virtual double lastFrameTimeUs() const = 0;
+  virtual double lastCapeTimeUs() const = 0;
+  /// A description for summary.json (body, URDF, attachment links, stepping).
+  virtual std::string describe() const = 0;
+};
+
+/// The simple body of SCENARIOS.md, no Bullet.
+std::unique_ptr<SceneRun> makeSimpleBodyRun(const RunOptions& options, std::string& error);
+
+}  // namespace cape::demo
+
+namespace cape::demo {
+/// The run the options ask for: the simple body, or a URDF character in a Bullet world. nullptr and a
+/// one-line reason on bad input (unreadable URDF, unknown link).
+std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& error);
+}  // namespace cape::demo

@@ -1,0 +1,196 @@
+// cape_walk: the headless walking demo. A character walks (or stands, sprints and turns, stands in the wind,
+// or walks in a crowd), its cape follows, and every metric of shared/SCENARIOS.md is written per frame.
+// `cape_walk --help` lists the options; with none it runs the walk scene into a fresh folder it names.
+#include "Progress.h"
+#include "RunOutput.h"
+#include "SceneRun.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <map>
+
+using namespace cape;
+using namespace cape::demo;
+
+namespace {
+
+nlohmann::json settingsJson(const CapeSettings& s) {
+  return {{"integrator", toString(s.integrator)},
+          {"structural_stiffness_n_per_m", s.structuralStiffness},
+          {"shear_stiffness_n_per_m", s.shearStiffness},
+          {"bend_stiffness_n_per_m", s.bendStiffness},
+          {"tethers", s.useTethers},
+          {"damping_per_s", s.damping},
+          {"collision_thickness_m", s.collisionThickness},
+          {"friction", s.friction},
+          {"substeps", s.substeps},
+          {"iterations", s.iterations},
+          {"gravity", {s.gravity.x(), s.gravity.y(), s.gravity.z()}},
+          {"self_collision", s.selfCollision}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"cape_walk: a character walks headlessly with a cape; writes metrics.csv, summary.json, "
+               "frames/NNNNN.obj and colliders.jsonl to an output folder."};
+  std::string scene = "walk", attachment = "corners", solver = "xpbd", out, urdf, attach;
+  int size = 20, characters = 3, threads = 1, substeps = -1;
+  double seconds = -1.0;
+  bool noFrames = false, simpleBody = false, selfCollision = false;
+  app.add_option("--scene", scene, "hang | walk | sprint-turn | wind | crowd")
+      ->check(CLI::IsMember({"hang", "walk", "sprint-turn", "wind", "crowd"}))
+      ->capture_default_str();
+  app.add_option("--size", size, "particles per side of the N x N cape")->check(CLI::Range(2, 256))->capture_default_str();
+  app.add_option("--attachment", attachment, "corners (the two top corners) | collar (the whole top row)")
+      ->check(CLI::IsMember({"corners", "collar"}))
+      ->capture_default_str();
+  app.add_option("--seconds", seconds, "simulated length, s (default: the scene's own length)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--solver", solver, "xpbd (default) | explicit (the seed's explicit springs)")
+      ->check(CLI::IsMember({"xpbd", "explicit"}))
+      ->capture_default_str();
+  app.add_option("--substeps", substeps, "solver substeps per 1/60 s frame (default: the solver's)")->check(CLI::Range(1, 64));
+  app.add_flag("--self-collision", selfCollision, "keep the cape from passing through itself");
+  app.add_option("--characters", characters, "characters in the crowd scene")->check(CLI::Range(1, 64))->capture_default_str();
+  app.add_option("--threads", threads, "worker threads stepping the capes")->check(CLI::Range(1, 256))->capture_default_str();
+  app.add_option("--out", out, "output folder (default: a fresh cape_run_<scene>_<time> folder)");
+  app.add_flag("--no-frames", noFrames, "do not write frames/*.obj");
+  app.add_flag("--simple-body", simpleBody, "use the simple body of SCENARIOS.md instead of a URDF character");
+  app.add_option("--urdf", urdf, "character URDF file (default: the shipped humanoid)")->check(CLI::ExistingFile);
+  app.add_option("--attach", attach, "comma-separated links the cape pins to (default: links named *shoulder*)");
+  CLI11_PARSE(app, argc, argv);
+
+  RunOptions o;
+  parseSceneKind(scene, o.scene);
+  parseAttachment(attachment, o.attachment);
+  o.size = size;
+  o.seconds = seconds;
+  o.characters = o.scene == SceneKind::Crowd ? characters : 1;
+  o.threads = threads;
+  o.simpleBody = simpleBody;
+  o.urdf = urdf;
+  for (std::size_t start = 0; !attach.empty() && start <= attach.size();) {
+    const std::size_t comma = attach.find(',', start);
+    const std::string link = attach.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (!link.empty()) o.attachLinks.push_back(link);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (solver == "explicit") {
+    o.settings = CapeSettings::seed();
+    o.settings.timeStep = 1.0f / 60.0f;
+    o.settings.substeps = 8;  // 1/480 s: within the explicit springs' stability bound (0.00875 s is the seed's)
+  }
+  if (substeps > 0) o.settings.substeps = substeps;
+  o.settings.selfCollision = selfCollision;
+  if (Status s = o.settings.validate(); !s.ok()) {
+    std::fprintf(stderr, "cape_walk: %s\n", s.message().c_str());
+    return 1;
+  }
+
+  std::string error;
+  std::unique_ptr<SceneRun> run = makeSceneRun(o, error);
+  if (!run) {
+    std::fprintf(stderr, "cape_walk: %s\n", error.c_str());
+    return 1;
+  }
+  const double length = o.seconds > 0.0 ? o.seconds : MotionDesc::forScene(o.scene).duration;
+  const int frames = static_cast<int>(std::lround(length * 60.0));
+  const std::filesystem::path dir = out.empty() ? freshRunFolder(scene) : std::filesystem::path(out);
+  std::unique_ptr<RunWriter> writer;
+  try {
+    writer = std::make_unique<RunWriter>(dir, !noFrames, run->characterCount());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "cape_walk: %s\n", e.what());
+    return 1;
+  }
+
+  std::vector<MetricsRecorder> recorders(static_cast<std::size_t>(run->characterCount()));
+  std::vector<SelfIntersectionCounter> counters(recorders.size());
+  std::vector<FrameRow> rows;
+  rows.reserve(static_cast<std::size_t>(frames));
+  Progress progress("cape_walk " + scene, frames);
+  bool blowUp = false;
+  for (int f = 1; f <= frames && !blowUp; ++f) {
+    run->advanceFrame();
+    FrameRow row;
+    row.frame = f;
+    row.time = f / 60.0;
+    row.frameTimeUs = run->lastFrameTimeUs();
+    row.capeTimeUs = run->lastCapeTimeUs();
+    std::vector<Collider> allColliders;
+    for (int k = 0; k < run->characterCount(); ++k) {
+      const std::vector<Collider> colliders = run->bodyColliders(k);
+      const FrameMetrics m = measureFrame(run->cape(k), colliders, run->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
+      recorders[static_cast<std::size_t>(k)].add(m);
+      // A crowd's row holds the worst of its characters.
+      row.metrics.maxStrain = k == 0 ? m.maxStrain : std::max(row.metrics.maxStrain, m.maxStrain);
+      row.metrics.meanStrain = std::max(row.metrics.meanStrain, m.meanStrain);
+      row.metrics.maxPenetration = std::max(row.metrics.maxPenetration, m.maxPenetration);
+      row.metrics.selfIntersections = std::max(row.metrics.selfIntersections, m.selfIntersections);
+      row.metrics.pinError = std::max(row.metrics.pinError, m.pinError);
+      row.metrics.meanSpeed = std::max(row.metrics.meanSpeed, m.meanSpeed);
+      row.metrics.blowUp = row.metrics.blowUp || m.blowUp;
+      writer->capeMesh(f, k, run->cape(k));
+      for (Collider c : colliders) {
+        if (run->characterCount() > 1) c.name = "k" + std::to_string(k) + "/" + c.name;
+        allColliders.push_back(std::move(c));
+      }
+    }
+    writer->frame(row);
+    writer->colliders(f, allColliders);
+    rows.push_back(row);
+    blowUp = row.metrics.blowUp;
+    progress.update(f);
+  }
+  progress.finish();
+
+  // Summary: per character and, for the table, the worst character.
+  MetricsRecorder worst;
+  for (const FrameRow& r : rows) worst.add(r.metrics);
+  const RunSummary q = worst.summary();
+  nlohmann::json summary;
+  summary["scene"] = scene;
+  summary["body"] = run->describe();
+  summary["attachment"] = attachment;
+  summary["characters"] = run->characterCount();
+  summary["threads"] = threads;
+  summary["grid"] = {{"columns", size}, {"rows", size}, {"particles", size * size},
+                     {"springs", run->cape(0).fabric().springCount()}};
+  summary["cape"] = {{"width_m", 0.6}, {"height_m", 1.0}, {"mass_kg", run->cape(0).fabric().totalMass()}};
+  summary["frame_time_s"] = 1.0 / 60.0;
+  summary["seconds"] = length;
+  summary["settings"] = settingsJson(o.settings);
+  summary["summary"] = summaryFigures(rows, q);
+  if (run->characterCount() > 1) {
+    for (std::size_t k = 0; k < recorders.size(); ++k) {
+      std::vector<FrameRow> own;
+      for (std::size_t f = 0; f < rows.size(); ++f) own.push_back({rows[f].frame, rows[f].time, rows[f].frameTimeUs, rows[f].capeTimeUs, recorders[k].frames()[f]});
+      summary["per_character"].push_back(summaryFigures(own, recorders[k].summary()));
+    }
+  }
+  writer->summary(summary);
+
+  const nlohmann::json& s = summary["summary"];
+  std::printf("cape_walk: scene %s, %d x %d cape, %d character(s), %d frames -> %s\n", scene.c_str(), size, size,
+              run->characterCount(), static_cast<int>(rows.size()), dir.c_str());
+  std::printf("  %-34s %10.1f us (p95 %.1f)\n", "frame time, median", s["frame_time_us_median"].get<double>(), s["frame_time_us_p95"].get<double>());
+  std::printf("  %-34s %10.1f us (p95 %.1f)\n", "cape time, median", s["cape_time_us_median"].get<double>(), s["cape_time_us_p95"].get<double>());
+  std::printf("  %-34s %10.2f %%  (median frame %.2f %%, p95 frame %.2f %%)\n", "strain, max", 100.0 * q.maxStrain, 100.0 * q.medianFrameMaxStrain, 100.0 * q.p95FrameMaxStrain);
+  std::printf("  %-34s %10.3f %%\n", "strain, mean", 100.0 * q.meanStrain);
+  std::printf("  %-34s %10.4f m  (%d frames over 1 mm)\n", "penetration, max", q.maxPenetration, q.framesPenetrationOver1mm);
+  std::printf("  %-34s %10d    (%d frames with any)\n", "self-intersections, max", q.selfIntersectionsMax, q.framesWithSelfIntersections);
+  std::printf("  %-34s %10.2g m\n", "pin error, max", q.pinErrorMax);
+  if (o.scene == SceneKind::Hang) std::printf("  %-34s %10.4f m/s\n", "rest jitter (last second)", q.restJitter);
+  std::printf("  %-34s %10s\n", "blow-up", q.blowUp ? "YES" : "no");
+  if (blowUp) {
+    std::fprintf(stderr, "cape_walk: the cape blew up at frame %d (NaN or a particle > 10 m from the torso)\n",
+                 static_cast<int>(rows.size()));
+    return 2;
+  }
+  return 0;
+}
