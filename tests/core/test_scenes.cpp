@@ -1,0 +1,128 @@
+// The canonical scenes of SCENARIOS.md on the simple body: the motions, and the quality bounds the solver
+// promises there (issue 2): walk strain median <= 3 %, p95 <= 5 %; sprint-turn penetration <= 1 mm.
+#include "CapeTestFixture.h"
+
+#include "cape/core/Metrics.h"
+#include "cape/core/Scene.h"
+
+#include <cmath>
+
+namespace cape {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+TEST(Scenes, ParseNames) {
+  SceneKind k;
+  for (SceneKind kind : {SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind, SceneKind::Crowd}) {
+    ASSERT_TRUE(parseSceneKind(toString(kind), k));
+    EXPECT_EQ(k, kind);
+  }
+  EXPECT_FALSE(parseSceneKind("dance", k));
+  Attachment a;
+  EXPECT_TRUE(parseAttachment("collar", a));
+  EXPECT_EQ(a, Attachment::Collar);
+  EXPECT_FALSE(parseAttachment("belt", a));
+}
+
+TEST(Scenes, WalkMotion) {
+  const MotionDesc m = MotionDesc::forScene(SceneKind::Walk);
+  EXPECT_FLOAT_EQ(m.speed, 1.4f);
+  const BodyPose p = motionAt(m, 1.0);
+  EXPECT_NEAR(p.position.z(), -1.4f, 1e-5f);  // walks towards -Z
+  EXPECT_NEAR(p.position.x(), 0.0f, 1e-6f);
+  EXPECT_NEAR(motionAt(m, 0.25).legAngle, 0.5236f * std::sin(2.0 * kPi * 0.25), 1e-5f);
+  // Bob: 3 cm peak to peak at 2 Hz.
+  float lo = 1.0f, hi = -1.0f;
+  for (int i = 0; i < 100; ++i) {
+    const float b = motionAt(m, i * 0.005).bob;
+    lo = std::min(lo, b);
+    hi = std::max(hi, b);
+  }
+  EXPECT_NEAR(hi - lo, 0.03f, 2e-3f);
+}
+
+TEST(Scenes, SprintTurnMotion) {
+  const MotionDesc m = MotionDesc::forScene(SceneKind::SprintTurn);
+  EXPECT_FLOAT_EQ(m.speed, 5.0f);
+  EXPECT_NEAR(motionAt(m, 1.5).yaw, 0.0f, 1e-6f);
+  EXPECT_NEAR(std::fabs(motionAt(m, 2.0).yaw), kPi, 1e-4f);  // half a turn after each 2 s period
+  EXPECT_NEAR(std::fabs(motionAt(m, 1.75).yaw), kPi / 2, 1e-4f);
+  // Speed along the path is 5 m/s everywhere (closed form, checked by a finite difference).
+  for (double t : {0.5, 1.6, 1.8, 3.9}) {
+    const float v = (motionAt(m, t + 1e-3).position - motionAt(m, t).position).norm() / 1e-3f;
+    EXPECT_NEAR(v, 5.0f, 0.05f) << "t = " << t;
+  }
+}
+
+TEST(Scenes, SimpleBodyMatchesScenarios) {
+  SimpleBody body;
+  body.moveTo(BodyPose{}, true);
+  const auto& c = body.colliders();
+  ASSERT_EQ(c.size(), 6u);
+  EXPECT_EQ(c[SimpleBody::kTorso].shape, ColliderShape::Box);
+  EXPECT_TRUE(c[SimpleBody::kTorso].halfExtents.isApprox(Vec3(0.20f, 0.30f, 0.12f)));
+  EXPECT_TRUE(c[SimpleBody::kTorso].current.position.isApprox(Vec3(0.0f, 1.25f, 0.0f)));
+  EXPECT_FLOAT_EQ(c[SimpleBody::kLeftShoulder].radius, 0.08f);
+  EXPECT_NEAR(std::fabs(c[SimpleBody::kLeftShoulder].current.position.x()), 0.22f, 1e-6f);
+  EXPECT_EQ(c[SimpleBody::kLeftLeg].shape, ColliderShape::Capsule);
+  // Total height 0.80 m = 2 * (halfHeight + radius); centre 0.40 m below the hip.
+  EXPECT_NEAR(2.0f * (c[SimpleBody::kLeftLeg].halfHeight + c[SimpleBody::kLeftLeg].radius), 0.80f, 1e-6f);
+  EXPECT_NEAR(c[SimpleBody::kLeftLeg].current.position.y(), 0.55f, 1e-6f);
+  EXPECT_EQ(c[SimpleBody::kGround].shape, ColliderShape::Plane);
+  EXPECT_EQ(body.bodyColliders().size, 5u);
+}
+
+TEST(Scenes, CapeRigs) {
+  const CapeRig corners = makeCapeRig(20, Attachment::Corners);
+  ASSERT_TRUE(corners.fabric);
+  EXPECT_EQ(corners.pinnedParticles.size(), 2u);
+  EXPECT_NEAR(corners.fabric->totalMass(), 0.4f, 1e-5f);
+  EXPECT_NEAR(std::fabs(corners.pinLocalPoints[0].x()), 0.30f, 1e-6f);
+  EXPECT_NEAR(corners.pinLocalPoints[0].y(), 1.56f, 1e-6f);
+  EXPECT_NEAR(corners.pinLocalPoints[0].z(), 0.15f, 1e-6f);
+  const CapeRig collar = makeCapeRig(20, Attachment::Collar);
+  EXPECT_EQ(collar.pinnedParticles.size(), 20u);
+}
+
+RunSummary runScene(SceneKind kind, int n = 20, double seconds = -1.0) {
+  SimpleScene scene(kind, n, Attachment::Corners, CapeSettings());
+  EXPECT_TRUE(scene.status().ok());
+  MetricsRecorder rec;
+  SelfIntersectionCounter counter;
+  const double length = seconds > 0 ? seconds : scene.motion().duration;
+  const int frames = static_cast<int>(std::lround(length * 60.0));
+  for (int f = 0; f < frames; ++f) {
+    scene.advanceFrame();
+    rec.add(measureFrame(scene.cape(), scene.body().bodyColliders(), scene.body().torsoCentre(), &counter));
+  }
+  return rec.summary();
+}
+
+TEST(Scenes, WalkMeetsTheStrainAndPenetrationBounds) {
+  const RunSummary s = runScene(SceneKind::Walk);
+  EXPECT_EQ(s.frames, 600);
+  EXPECT_FALSE(s.blowUp);
+  EXPECT_LE(s.medianFrameMaxStrain, 0.03f);
+  EXPECT_LE(s.p95FrameMaxStrain, 0.05f);
+  EXPECT_EQ(s.framesPenetrationOver1mm, 0) << "max " << s.maxPenetration;
+  EXPECT_LT(s.pinErrorMax, 1e-5f);
+}
+
+TEST(Scenes, SprintTurnLeavesNoParticleDeeperThan1mm) {
+  const RunSummary s = runScene(SceneKind::SprintTurn);
+  EXPECT_FALSE(s.blowUp);
+  EXPECT_LE(s.maxPenetration, 0.001f);
+  EXPECT_EQ(s.framesPenetrationOver1mm, 0);
+  EXPECT_LT(s.pinErrorMax, 1e-5f);
+}
+
+TEST(Scenes, HangSettles) {
+  const RunSummary s = runScene(SceneKind::Hang);
+  EXPECT_FALSE(s.blowUp);
+  EXPECT_LT(s.restJitter, 0.01f) << "mean particle speed over the last second, m/s";
+  EXPECT_EQ(s.framesPenetrationOver1mm, 0);
+}
+
+}  // namespace
+}  // namespace cape
