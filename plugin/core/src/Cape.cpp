@@ -1,5 +1,7 @@
 #include "cape/core/Cape.h"
 
+#include "cape/core/Wind.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -66,6 +68,17 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   freeMask_ = Eigen::VectorXf::Ones(n);
   lambda_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric_->springCount()));
   invDenominator_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric_->springCount()));
+  airVelocity_ = Points::Zero(n, 3);
+  // Each particle's share of the cloth's rest area (a third of each triangle it belongs to), m^2: the
+  // seed's sine-wave wind pushes on it.
+  particleArea_ = Eigen::VectorXf::Zero(n);
+  const std::vector<std::uint32_t>& tri = fabric_->triangles();
+  const Points& rest = fabric_->restPositions();
+  for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
+    const Vec3 a = rest.row(tri[t]).transpose(), b = rest.row(tri[t + 1]).transpose(), c = rest.row(tri[t + 2]).transpose();
+    const float third = (b - a).cross(c - a).norm() / 6.0f;
+    for (int k = 0; k < 3; ++k) particleArea_[tri[t + static_cast<std::size_t>(k)]] += third;
+  }
   colliderEnd_.reserve(64);
   contacts_.reserve(static_cast<std::size_t>(4 * n));
   distance2_.resize(n);
@@ -147,6 +160,10 @@ void Cape::step(float dt, ColliderSpan colliders) {
   // 1 for free particles, 0 for pinned ones (same size every step: no allocation).
   freeMask_ = (state_.inverseMasses.array() > 0.0f).cast<float>();
   if (settings_.integrator == Integrator::Xpbd) prepareSpringDenominators(h);
+  // The air's velocity at each particle, once per step at its middle: gusts change over tenths of a second,
+  // far slower than a frame.
+  if (settings_.wind.model != WindSettings::Model::None)
+    windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt), airVelocity_);
   for (int k = 0; k < substeps; ++k) {
     const float s0 = static_cast<float>(k) / static_cast<float>(substeps);
     const float s1 = static_cast<float>(k + 1) / static_cast<float>(substeps);
@@ -169,14 +186,43 @@ void Cape::movePinsTo(float s, float h) {
   }
 }
 
-void Cape::accumulateExternalAcceleration(float /*t*/) {
+void Cape::accumulateExternalAcceleration() {
   // Gravity on free particles only: pinned particles (inverse mass 0) feel nothing.
   for (int c = 0; c < 3; ++c) acceleration_.col(c) = freeMask_ * settings_.gravity[c];
+  const WindSettings& wind = settings_.wind;
+  if (wind.model == WindSettings::Model::SineWave) {
+    // The seed's wind: quadratic drag of each particle's area share, whatever the cloth's orientation.
+    const float q = 0.5f * wind.airDensity * wind.dragCoefficient;
+    for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
+      const Vec3 u = (airVelocity_.row(i) - state_.velocities.row(i)).transpose();
+      acceleration_.row(i) += (state_.inverseMasses[i] * q * particleArea_[i] * u.norm()) * u.transpose();
+    }
+  } else if (wind.model == WindSettings::Model::Aerodynamic) {
+    // Per triangle, from the air's velocity relative to the triangle (averages of its corners); a third of
+    // the force goes to each corner.
+    const std::vector<std::uint32_t>& tri = fabric_->triangles();
+    const Points& x = state_.positions;
+    const Points& v = state_.velocities;
+    const float* w = state_.inverseMasses.data();
+    for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
+      const std::uint32_t i = tri[t], j = tri[t + 1], k = tri[t + 2];
+      const Vec3 xi = x.row(i).transpose();
+      const Vec3 areaNormal = 0.5f * (x.row(j).transpose() - xi).cross(x.row(k).transpose() - xi);
+      const Vec3 u = ((airVelocity_.row(i) + airVelocity_.row(j) + airVelocity_.row(k)) -
+                      (v.row(i) + v.row(j) + v.row(k)))
+                         .transpose() /
+                     3.0f;
+      const Vec3 third = aerodynamicForce(u, areaNormal, wind.airDensity, wind.dragCoefficient, wind.liftCoefficient) / 3.0f;
+      acceleration_.row(i) += w[i] * third.transpose();
+      acceleration_.row(j) += w[j] * third.transpose();
+      acceleration_.row(k) += w[k] * third.transpose();
+    }
+  }
 }
 
 void Cape::stepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
   startPositions_ = state_.positions;
-  accumulateExternalAcceleration(static_cast<float>(state_.time) + s1 * h);
+  accumulateExternalAcceleration();
   // Predict: x* = x + h v + h^2 a (symplectic Euler on the external forces).
   state_.velocities += h * acceleration_;
   state_.positions += h * state_.velocities;
@@ -305,7 +351,7 @@ void Cape::solveTethers() {
 
 void Cape::stepExplicit(float h, float s0, float s1, ColliderSpan colliders) {
   // The seed: F = m g - m c v + sum of Hooke forces k (|d| - L) d / |d|; v += h F / m; x += h v.
-  accumulateExternalAcceleration(static_cast<float>(state_.time) + s1 * h);
+  accumulateExternalAcceleration();
   const float* px = state_.positions.col(0).data();
   const float* py = state_.positions.col(1).data();
   const float* pz = state_.positions.col(2).data();

@@ -21,6 +21,23 @@ constexpr float kLegCentreBelowHip = 0.40f;
 const Vec3 kPinLine(0.30f, 1.56f, 0.15f);
 }  // namespace
 
+WindSettings sceneWind(SceneKind kind) {
+  WindSettings w;
+  if (kind != SceneKind::Wind) return w;
+  w.model = WindSettings::Model::Aerodynamic;
+  w.direction = Vec3::UnitX();
+  w.speed = 8.0f;
+  w.gustAmplitude = 0.5f;
+  w.gustFrequency = 0.5f;
+  w.turbulenceScale = 2.0f;
+  return w;
+}
+
+CapeSettings settingsForScene(SceneKind kind, CapeSettings settings) {
+  if (settings.wind.model == WindSettings::Model::None) settings.wind = sceneWind(kind);
+  return settings;
+}
+
 const char* toString(SceneKind kind) {
   switch (kind) {
     case SceneKind::Hang: return "hang";
@@ -202,7 +219,7 @@ SimpleScene::SimpleScene(SceneKind kind, int n, Attachment attachment, const Cap
       motion_(MotionDesc::forScene(kind)),
       rig_(makeCapeRig(n, attachment, settings.bendStiffness > 0.0f)),
       body_(offset),
-      cape_(rig_.fabric, settings,
+      cape_(rig_.fabric, settingsForScene(kind, settings),
             Pose{offset + capeStartPlacement(kind).position, capeStartPlacement(kind).rotation}),
       offset_(offset) {
   if (!cape_.ok()) return;

@@ -75,7 +75,7 @@ class Cape {
   void prepareSpringDenominators(float h);
   void solveSprings(float h);
   void solveTethers();
-  void accumulateExternalAcceleration(float t);
+  void accumulateExternalAcceleration();
 
   FabricPtr fabric_;
   CapeSettings settings_;
@@ -89,6 +89,8 @@ class Cape {
   Eigen::VectorXf lambda_;       ///< XPBD Lagrange multipliers of every spring, per substep.
   Eigen::VectorXf invDenominator_;  ///< 1 / (w_i + w_j + alpha~) of every spring, per step.
   std::vector<float> familyCompliance_;
+  Points airVelocity_;           ///< The wind's velocity at each particle for this step, m/s.
+  Eigen::VectorXf particleArea_; ///< Each particle's share of the rest area, m^2 (the seed's wind).
   std::vector<Pose> colliderEnd_;   ///< Collider poses at the end of the substep.
   std::vector<Contact> contacts_;   ///< Contacts of the substep's collision pass.
   Eigen::ArrayXf distance2_;        ///< Broad-phase scratch, one per particle.

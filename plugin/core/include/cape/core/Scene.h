@@ -33,6 +33,12 @@ struct MotionDesc {
   static MotionDesc forScene(SceneKind kind);
 };
 
+/// The scene's wind: for "wind", the aerodynamic model at 8 m/s mean along +X with gusts of +-50 % (0.5 Hz,
+/// 2 m turbulence); no wind in every other scene.
+WindSettings sceneWind(SceneKind kind);
+/// `settings` with the scene's wind filled in when the settings name none (an explicit wind wins).
+CapeSettings settingsForScene(SceneKind kind, CapeSettings settings);
+
 /// The character's pose at a time: its frame (origin on the ground between the feet, facing -Z when yaw = 0),
 /// the torso bob and the left leg angle (the right leg is its negative).
 struct BodyPose {
