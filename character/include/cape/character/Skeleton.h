@@ -1,0 +1,102 @@
+// Forward kinematics of a URDF model in the Y-up world of shared/SCENARIOS.md.
+//
+// Frames, from the world inwards:
+//   world (Y up, metres; the character faces -Z at yaw 0)
+//     <- root transform: position on the ground + yaw about world +Y (setRoot)
+//     <- urdfToWorld(): the fixed rotation taking the URDF's REP-103 axes into the world:
+//          URDF +x (forward) -> world -Z,  URDF +y (left) -> world -X,  URDF +z (up) -> world +Y
+//     <- the URDF root link, then each joint: origin (translation times scale) * motion(q)
+// The uniform scale multiplies every length of the model (joint origins, prismatic travel, shape sizes); link
+// frames stay rigid (rotation matrices stay orthonormal), so a link pose is always a proper rigid transform.
+#pragma once
+
+#include "cape/character/Status.h"
+#include "cape/character/Urdf.h"
+
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+namespace cape::character {
+
+/// One collision shape placed in the world: for exporting colliders frame by frame.
+struct WorldShape {
+  int link = -1;
+  const std::string* linkName = nullptr;  ///< points into the model; valid while the Skeleton lives
+  const ShapeDesc* shape = nullptr;       ///< sizes in world metres (scale applied); valid while the Skeleton lives
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< the shape's frame in the world
+};
+
+class Skeleton {
+ public:
+  /// The rotation taking URDF axes (x forward, y left, z up) into the world (x right, y up, z backward).
+  static Eigen::Matrix3d urdfToWorld();
+
+  /// `model` must not be null. Joints start at rest (see restPosition), the root at the world origin, yaw 0.
+  explicit Skeleton(UrdfModelPtr model);
+
+  const UrdfModel& model() const { return *model_; }
+  const UrdfModelPtr& modelPtr() const { return model_; }
+  int linkCount() const { return static_cast<int>(model_->links().size()); }
+  int jointCount() const { return static_cast<int>(model_->joints().size()); }
+
+  /// Uniform scale of the whole model, > 0 (1 = the URDF's own size). InvalidArgument otherwise.
+  Status setScale(double scale);
+  double scale() const { return scale_; }
+
+  // --- Joint positions (rad for revolute and continuous joints, URDF metres for prismatic ones) ---------------
+  /// Index of a joint, -1 if none.
+  int jointIndex(const std::string& name) const { return model_->findJoint(name); }
+  /// Sets a joint's position. Errors: UnknownJoint; NotMovable (fixed, floating, planar); InvalidArgument (not
+  /// finite; nothing changes). A value outside the limits is clamped to them, applied, and reported as
+  /// OutsideLimits so the caller can tell; every other success returns ok.
+  Status setJointPosition(const std::string& name, double q);
+  Status setJointPosition(int joint, double q);
+  /// UnknownJoint if there is no such joint.
+  Status jointPosition(const std::string& name, double& q) const;
+  double jointPosition(int joint) const { return q_[static_cast<std::size_t>(joint)]; }
+  /// One value per joint, in model().joints() order (0 for joints that are not movable).
+  const std::vector<double>& jointPositions() const { return q_; }
+  /// Rest position of a joint: 0, or the nearest limit when 0 lies outside the limits.
+  double restPosition(int joint) const;
+  /// q clamped into the joint's limits (unchanged for joints without limits).
+  double clampToLimits(int joint, double q) const;
+  /// Every joint back to its rest position.
+  void resetJointPositions();
+
+  // --- Root ----------------------------------------------------------------------------------------------------
+  /// The character frame: `position` in the world (m; the URDF origin, for the shipped humanoid the ground point
+  /// between the feet), `yaw` in rad about world +Y (0 faces -Z, as motionAt in the core's Scene.h).
+  void setRoot(const Eigen::Vector3d& position, double yaw);
+  /// Any rigid character frame (the URDF-to-world rotation is applied inside it).
+  void setRootTransform(const Eigen::Isometry3d& root);
+  const Eigen::Isometry3d& rootTransform() const { return root_; }
+
+  // --- Poses ---------------------------------------------------------------------------------------------------
+  /// World pose of a link's frame (computed on demand after any change; not safe to call from two threads at
+  /// once on one Skeleton).
+  const Eigen::Isometry3d& linkPose(int link) const;
+  /// UnknownLink if there is no such link.
+  Status linkPose(const std::string& name, Eigen::Isometry3d& pose) const;
+  /// A link's collision shapes with the scale applied (origins in the link frame).
+  const std::vector<ShapeDesc>& shapes(int link) const { return shapes_[static_cast<std::size_t>(link)]; }
+  /// Every collision shape of every link placed in the world, in link order; `out` is reused (no allocation
+  /// once it has grown).
+  void worldShapes(std::vector<WorldShape>& out) const;
+  std::vector<WorldShape> worldShapes() const;
+
+ private:
+  void updatePoses() const;
+  void rebuildShapes();
+
+  UrdfModelPtr model_;
+  double scale_ = 1.0;
+  std::vector<double> q_;
+  Eigen::Isometry3d root_ = Eigen::Isometry3d::Identity();
+  std::vector<std::vector<ShapeDesc>> shapes_;  ///< per link, scaled
+  mutable std::vector<Eigen::Isometry3d> poses_;  ///< per link, world
+  mutable bool dirty_ = true;
+};
+
+}  // namespace cape::character

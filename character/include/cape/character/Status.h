@@ -1,0 +1,45 @@
+// The error value of the character module: bad data (a URDF file, an unknown joint name) never throws and never
+// crashes; it comes back as a Status with a code a program can test and a message meant for a person.
+#pragma once
+
+#include <string>
+#include <utility>
+
+namespace cape::character {
+
+enum class ErrorCode : int {
+  Ok = 0,
+  FileNotFound,     ///< The URDF path does not name a readable regular file.
+  MalformedXml,     ///< The text is not well-formed XML (unclosed or mismatched tags, bad attributes, ...).
+  InvalidModel,     ///< Well-formed XML that is not a valid URDF (no <robot>, a revolute joint without limits, ...).
+  MissingLink,      ///< A joint names a parent or child link that is not defined.
+  NotATree,         ///< No single root, or links unreachable from it: a cycle or a disconnected part.
+  UnknownJoint,     ///< No joint of that name.
+  UnknownLink,      ///< No link of that name.
+  OutsideLimits,    ///< A joint value outside its limits: it was clamped (see the message) and applied.
+  NotMovable,       ///< A fixed (or floating/planar) joint has no single position to set.
+  InvalidArgument,  ///< A non-finite value, a non-positive scale or time step, ...
+};
+
+const char* toString(ErrorCode code);
+
+class Status {
+ public:
+  Status() = default;  ///< Success.
+  static Status success() { return Status(); }
+  static Status error(ErrorCode code, std::string message) { return Status(code, std::move(message)); }
+
+  bool ok() const { return code_ == ErrorCode::Ok; }
+  explicit operator bool() const { return ok(); }
+  ErrorCode code() const { return code_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  Status(ErrorCode code, std::string message) : code_(code), message_(std::move(message)) {
+    if (code_ != ErrorCode::Ok && message_.empty()) message_ = toString(code_);
+  }
+  ErrorCode code_ = ErrorCode::Ok;
+  std::string message_;
+};
+
+}  // namespace cape::character

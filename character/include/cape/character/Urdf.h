@@ -1,0 +1,117 @@
+// A URDF robot description loaded with urdfdom into plain data: links with their collision shapes, joints with
+// their origins, axes and limits, in a parents-before-children order. Everything here is in the URDF's own
+// frame and units (REP 103: metres, radians, Z up, X forward); Skeleton maps it into the Y-up world.
+//
+// Loading never throws and never crashes on bad data: it returns a Status (see Status.h) naming the problem.
+// urdfdom prints its diagnostics through console_bridge; while we parse they are captured instead and folded
+// into our error message or, for a model that loads, into warnings().
+#pragma once
+
+#include "cape/character/Status.h"
+
+#include <Eigen/Geometry>
+
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace cape::character {
+
+/// Collision primitives. URDF (and urdfdom 3.0) has no capsule; mesh elements are not loaded (see warnings()).
+enum class ShapeType : int { Sphere, Box, Cylinder };
+const char* toString(ShapeType type);
+
+/// One collision element of a link, in the link's frame.
+struct ShapeDesc {
+  ShapeType type = ShapeType::Sphere;
+  double radius = 0.0;                                 ///< m; sphere and cylinder
+  double halfLength = 0.0;                             ///< m; cylinder, along its local z axis (URDF rule)
+  Eigen::Vector3d halfExtents = Eigen::Vector3d::Zero();  ///< m; box, along its local x, y, z
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< shape frame in the link frame
+  std::string name;  ///< the element's name attribute, or "<link>#<k>" when it has none
+};
+
+enum class JointType : int { Fixed, Revolute, Continuous, Prismatic, Floating, Planar };
+const char* toString(JointType type);
+
+struct LinkDesc {
+  std::string name;
+  int parentJoint = -1;  ///< index into UrdfModel::joints(); -1 for the root
+  int parentLink = -1;   ///< index into UrdfModel::links(); -1 for the root
+  std::vector<int> childJoints;
+  std::vector<ShapeDesc> shapes;  ///< collision elements (meshes left out, with a warning)
+  double mass = 0.0;              ///< kg, from <inertial>; 0 when absent
+};
+
+struct JointDesc {
+  std::string name;
+  JointType type = JointType::Fixed;
+  int parentLink = -1;
+  int childLink = -1;
+  Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< child joint frame in the parent link frame
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();           ///< unit vector in the joint frame
+  bool hasLimits = false;  ///< revolute and prismatic always; continuous never (position is unbounded)
+  double lower = 0.0;      ///< rad (revolute) or m (prismatic)
+  double upper = 0.0;
+  double maxVelocity = 0.0;  ///< rad/s or m/s, as written in <limit velocity=...>; 0 when absent
+
+  /// One scalar position (revolute, continuous, prismatic); fixed, floating and planar joints have none.
+  bool isMovable() const {
+    return type == JointType::Revolute || type == JointType::Continuous || type == JointType::Prismatic;
+  }
+};
+
+class UrdfModel;
+using UrdfModelPtr = std::shared_ptr<const UrdfModel>;
+
+/// What a load returns: ok and a model, or an error status and no model.
+struct UrdfLoadResult {
+  Status status;
+  UrdfModelPtr model;
+  bool ok() const { return status.ok() && model != nullptr; }
+};
+
+/// Shared and immutable once loaded: any number of Skeletons may use one model.
+class UrdfModel {
+ public:
+  /// Reads and parses a URDF file. FileNotFound when the path is not a readable regular file.
+  static UrdfLoadResult fromFile(const std::string& path);
+  /// Parses URDF text.
+  static UrdfLoadResult fromString(const std::string& xml);
+  /// The humanoid shipped in character/models/humanoid.urdf, compiled into the library (no file needed).
+  static UrdfLoadResult humanoid();
+  /// The text of that humanoid.
+  static const std::string& humanoidUrdf();
+
+  const std::string& name() const { return name_; }
+  /// Links in parents-before-children order; links()[rootLink()] is the root (index 0).
+  const std::vector<LinkDesc>& links() const { return links_; }
+  const std::vector<JointDesc>& joints() const { return joints_; }
+  int rootLink() const { return 0; }
+  /// Index of the link or joint of that name, -1 if none.
+  int findLink(const std::string& name) const;
+  int findJoint(const std::string& name) const;
+  /// Names of the links whose name contains `part` (case-insensitive), in link order: "shoulder" finds the
+  /// shipped humanoid's left_shoulder and right_shoulder.
+  std::vector<std::string> linksContaining(const std::string& part) const;
+  /// Things that loaded but not as written: mesh elements left out, geometry urdfdom could not read, ... Each
+  /// names its link.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  friend struct UrdfModelBuilder;
+  std::string name_;
+  std::vector<LinkDesc> links_;
+  std::vector<JointDesc> joints_;
+  std::unordered_map<std::string, int> linkIndex_;
+  std::unordered_map<std::string, int> jointIndex_;
+  std::vector<std::string> warnings_;
+};
+
+/// Checks that `text` is well-formed XML with a single root element (tags balanced and matched, attributes
+/// quoted, comments, CDATA, processing instructions and a DOCTYPE allowed). On failure `message` says what and
+/// on which line. Used before urdfdom so that broken XML is told apart from a broken robot description.
+bool checkXmlWellFormed(const std::string& text, std::string& message);
+
+}  // namespace cape::character

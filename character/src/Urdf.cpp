@@ -1,0 +1,358 @@
+// Loading a URDF with urdfdom into the plain data of Urdf.h, with every failure turned into a Status.
+#include "cape/character/Urdf.h"
+
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+namespace cape::character {
+
+const char* toString(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::Ok: return "ok";
+    case ErrorCode::FileNotFound: return "file not found";
+    case ErrorCode::MalformedXml: return "malformed XML";
+    case ErrorCode::InvalidModel: return "invalid URDF model";
+    case ErrorCode::MissingLink: return "missing link";
+    case ErrorCode::NotATree: return "links do not form a tree";
+    case ErrorCode::UnknownJoint: return "unknown joint";
+    case ErrorCode::UnknownLink: return "unknown link";
+    case ErrorCode::OutsideLimits: return "outside joint limits";
+    case ErrorCode::NotMovable: return "joint not movable";
+    case ErrorCode::InvalidArgument: return "invalid argument";
+  }
+  return "unknown error";
+}
+
+const char* toString(ShapeType type) {
+  switch (type) {
+    case ShapeType::Sphere: return "sphere";
+    case ShapeType::Box: return "box";
+    case ShapeType::Cylinder: return "cylinder";
+  }
+  return "unknown";
+}
+
+const char* toString(JointType type) {
+  switch (type) {
+    case JointType::Fixed: return "fixed";
+    case JointType::Revolute: return "revolute";
+    case JointType::Continuous: return "continuous";
+    case JointType::Prismatic: return "prismatic";
+    case JointType::Floating: return "floating";
+    case JointType::Planar: return "planar";
+  }
+  return "unknown";
+}
+
+namespace {
+
+// Collects what urdfdom prints through console_bridge while one parse runs. console_bridge's handler is
+// process-wide, so parses are serialised by a mutex; the handler in use before is restored afterwards.
+class CapturedConsole : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char* /*filename*/,
+           int /*line*/) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+      errors.push_back(text);
+    } else if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
+      warnings.push_back(text);
+    }
+  }
+  std::vector<std::string> errors;
+  std::vector<std::string> warnings;
+};
+
+std::mutex& parseMutex() {
+  static std::mutex m;
+  return m;
+}
+
+Eigen::Isometry3d toIsometry(const urdf::Pose& p) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  Eigen::Quaterniond q(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z);
+  if (q.norm() > 0.0) q.normalize();
+  t.linear() = q.toRotationMatrix();
+  t.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
+  return t;
+}
+
+std::string joinLines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const std::string& l : lines) {
+    if (!out.empty()) out += "; ";
+    out += l;
+  }
+  return out;
+}
+
+bool contains(const std::string& text, const char* part) { return text.find(part) != std::string::npos; }
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+}  // namespace
+
+// Builds a UrdfModel from urdfdom's model; a friend of UrdfModel.
+struct UrdfModelBuilder {
+  static Status build(const urdf::ModelInterface& in, std::vector<std::string> warnings,
+                      std::shared_ptr<UrdfModel>& out) {
+    auto model = std::make_shared<UrdfModel>();
+    model->name_ = in.name_;
+    model->warnings_ = std::move(warnings);
+    urdf::LinkConstSharedPtr root = in.getRoot();
+    if (!root) return Status::error(ErrorCode::NotATree, "URDF '" + in.name_ + "' has no root link");
+
+    // Breadth-first from the root: parents come before children. urdfdom gives each link one parent, so a
+    // cycle (or a second tree) shows up as links never reached from the root.
+    std::vector<urdf::LinkConstSharedPtr> order{root};
+    model->linkIndex_[root->name] = 0;
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      for (const urdf::LinkSharedPtr& child : order[k]->child_links) {
+        if (!child || model->linkIndex_.count(child->name) != 0) continue;
+        model->linkIndex_[child->name] = static_cast<int>(order.size());
+        order.push_back(child);
+      }
+    }
+    if (order.size() != in.links_.size()) {
+      std::string missing;
+      for (const auto& [name, link] : in.links_) {
+        if (model->linkIndex_.count(name) == 0) missing += (missing.empty() ? "" : ", ") + name;
+      }
+      return Status::error(ErrorCode::NotATree, "URDF '" + in.name_ + "': links not connected to the root '" +
+                                                    root->name + "' (a cycle or a second tree): " + missing);
+    }
+
+    model->links_.resize(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      const urdf::Link& src = *order[k];
+      LinkDesc& link = model->links_[k];
+      link.name = src.name;
+      if (src.inertial) link.mass = src.inertial->mass;
+      Status s = readShapes(src, link, model->warnings_);
+      if (!s.ok()) return s;
+    }
+
+    for (std::size_t k = 1; k < order.size(); ++k) {
+      const urdf::JointSharedPtr& src = order[k]->parent_joint;
+      if (!src) return Status::error(ErrorCode::NotATree, "link '" + order[k]->name + "' has no parent joint");
+      JointDesc joint;
+      joint.name = src->name;
+      Status s = readJoint(*src, joint);
+      if (!s.ok()) return s;
+      joint.parentLink = model->linkIndex_.at(src->parent_link_name);
+      joint.childLink = static_cast<int>(k);
+      const int index = static_cast<int>(model->joints_.size());
+      model->jointIndex_[joint.name] = index;
+      model->links_[k].parentJoint = index;
+      model->links_[k].parentLink = joint.parentLink;
+      model->links_[joint.parentLink].childJoints.push_back(index);
+      model->joints_.push_back(std::move(joint));
+    }
+    out = std::move(model);
+    return Status::success();
+  }
+
+  static Status readJoint(const urdf::Joint& src, JointDesc& joint) {
+    switch (src.type) {
+      case urdf::Joint::REVOLUTE: joint.type = JointType::Revolute; break;
+      case urdf::Joint::CONTINUOUS: joint.type = JointType::Continuous; break;
+      case urdf::Joint::PRISMATIC: joint.type = JointType::Prismatic; break;
+      case urdf::Joint::FLOATING: joint.type = JointType::Floating; break;
+      case urdf::Joint::PLANAR: joint.type = JointType::Planar; break;
+      case urdf::Joint::FIXED: joint.type = JointType::Fixed; break;
+      default: return Status::error(ErrorCode::InvalidModel, "joint '" + src.name + "' has an unknown type");
+    }
+    joint.origin = toIsometry(src.parent_to_joint_origin_transform);
+    const Eigen::Vector3d axis(src.axis.x, src.axis.y, src.axis.z);
+    if (joint.isMovable()) {
+      if (!axis.allFinite() || axis.norm() < 1e-9) {
+        return Status::error(ErrorCode::InvalidModel, "joint '" + src.name + "' has a zero axis");
+      }
+      joint.axis = axis.normalized();
+    }
+    if (src.limits) {
+      joint.maxVelocity = src.limits->velocity;
+      if (joint.type == JointType::Revolute || joint.type == JointType::Prismatic) {
+        joint.hasLimits = true;
+        joint.lower = src.limits->lower;
+        joint.upper = src.limits->upper;
+        if (!(joint.lower <= joint.upper)) {
+          return Status::error(ErrorCode::InvalidModel, "joint '" + src.name + "' has lower limit " +
+                                                            std::to_string(joint.lower) + " above upper " +
+                                                            std::to_string(joint.upper));
+        }
+      }
+    }
+    return Status::success();
+  }
+
+  static Status readShapes(const urdf::Link& src, LinkDesc& link, std::vector<std::string>& warnings) {
+    // collision_array holds every <collision>; older files may fill only `collision`.
+    std::vector<urdf::CollisionSharedPtr> elements = src.collision_array;
+    if (elements.empty() && src.collision) elements.push_back(src.collision);
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+      const urdf::Collision& c = *elements[e];
+      const std::string label = c.name.empty() ? src.name + "#" + std::to_string(e) : c.name;
+      if (!c.geometry) {
+        warnings.push_back("link '" + src.name + "': collision element " + std::to_string(e) +
+                           " has no geometry; skipped");
+        continue;
+      }
+      ShapeDesc shape;
+      shape.name = label;
+      shape.origin = toIsometry(c.origin);
+      switch (c.geometry->type) {
+        case urdf::Geometry::SPHERE: {
+          const auto& g = static_cast<const urdf::Sphere&>(*c.geometry);
+          shape.type = ShapeType::Sphere;
+          shape.radius = g.radius;
+          break;
+        }
+        case urdf::Geometry::BOX: {
+          const auto& g = static_cast<const urdf::Box&>(*c.geometry);
+          shape.type = ShapeType::Box;
+          shape.halfExtents = 0.5 * Eigen::Vector3d(g.dim.x, g.dim.y, g.dim.z);
+          break;
+        }
+        case urdf::Geometry::CYLINDER: {
+          const auto& g = static_cast<const urdf::Cylinder&>(*c.geometry);
+          shape.type = ShapeType::Cylinder;
+          shape.radius = g.radius;
+          shape.halfLength = 0.5 * g.length;
+          break;
+        }
+        case urdf::Geometry::MESH: {
+          // We load no mesh files: the element is skipped, and the caller is told which link lost it.
+          const auto& g = static_cast<const urdf::Mesh&>(*c.geometry);
+          warnings.push_back("link '" + src.name + "': collision element '" + label + "' is a mesh ('" +
+                             g.filename + "'); meshes are not supported, the element is skipped");
+          continue;
+        }
+        default:
+          warnings.push_back("link '" + src.name + "': collision element '" + label +
+                             "' has an unsupported geometry; skipped");
+          continue;
+      }
+      const bool finite = std::isfinite(shape.radius) && std::isfinite(shape.halfLength) &&
+                          shape.halfExtents.allFinite() && shape.origin.matrix().allFinite();
+      const bool positive = (shape.type == ShapeType::Box) ? (shape.halfExtents.array() > 0.0).all()
+                                                            : shape.radius > 0.0 &&
+                                                                  (shape.type != ShapeType::Cylinder ||
+                                                                   shape.halfLength > 0.0);
+      if (!finite || !positive) {
+        return Status::error(ErrorCode::InvalidModel, "link '" + src.name + "': collision element '" + label +
+                                                          "' has a non-positive or non-finite size");
+      }
+      link.shapes.push_back(std::move(shape));
+    }
+    return Status::success();
+  }
+};
+
+UrdfLoadResult UrdfModel::fromString(const std::string& xml) {
+  UrdfLoadResult result;
+  std::string xmlError;
+  if (!checkXmlWellFormed(xml, xmlError)) {
+    result.status = Status::error(ErrorCode::MalformedXml, "URDF is not well-formed XML: " + xmlError);
+    return result;
+  }
+
+  CapturedConsole console;
+  urdf::ModelInterfaceSharedPtr parsed;
+  bool threw = false;
+  std::string thrown;
+  {
+    std::lock_guard<std::mutex> lock(parseMutex());
+    console_bridge::useOutputHandler(&console);
+    try {
+      parsed = urdf::parseURDF(xml);
+    } catch (const std::exception& e) {
+      threw = true;
+      thrown = e.what();
+    } catch (...) {
+      threw = true;
+      thrown = "unknown exception";
+    }
+    console_bridge::restorePreviousOutputHandler();
+  }
+  if (threw) console.errors.push_back("urdfdom threw: " + thrown);
+
+  if (!parsed) {
+    const std::string what = joinLines(console.errors.empty() ? console.warnings : console.errors);
+    ErrorCode code = ErrorCode::InvalidModel;
+    if (contains(what, "not found")) {
+      code = ErrorCode::MissingLink;  // "parent link [x] of joint [j] not found" (or child)
+    } else if (contains(what, "root link")) {
+      code = ErrorCode::NotATree;  // "No root link found" (a cycle) or "Two root links found"
+    }
+    result.status = Status::error(code, "URDF rejected by urdfdom: " + (what.empty() ? "no reason given" : what));
+    return result;
+  }
+
+  // urdfdom may skip what it cannot read (an unknown geometry, say) and still return a model: keep its words.
+  std::vector<std::string> warnings;
+  for (const std::string& e : console.errors) warnings.push_back("urdfdom: " + e);
+  for (const std::string& w : console.warnings) warnings.push_back("urdfdom: " + w);
+
+  std::shared_ptr<UrdfModel> model;
+  try {
+    result.status = UrdfModelBuilder::build(*parsed, std::move(warnings), model);
+  } catch (const std::exception& e) {
+    result.status = Status::error(ErrorCode::InvalidModel, std::string("URDF could not be read: ") + e.what());
+  }
+  if (result.status.ok()) result.model = std::move(model);
+  return result;
+}
+
+UrdfLoadResult UrdfModel::fromFile(const std::string& path) {
+  UrdfLoadResult result;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    result.status = Status::error(ErrorCode::FileNotFound, "URDF file '" + path + "' does not exist or is not a file");
+    return result;
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  if (!in || !(text << in.rdbuf())) {
+    result.status = Status::error(ErrorCode::FileNotFound, "URDF file '" + path + "' cannot be read");
+    return result;
+  }
+  result = fromString(text.str());
+  if (!result.status.ok()) {
+    result.status = Status::error(result.status.code(), path + ": " + result.status.message());
+  }
+  return result;
+}
+
+UrdfLoadResult UrdfModel::humanoid() { return fromString(humanoidUrdf()); }
+
+int UrdfModel::findLink(const std::string& name) const {
+  const auto it = linkIndex_.find(name);
+  return it == linkIndex_.end() ? -1 : it->second;
+}
+
+int UrdfModel::findJoint(const std::string& name) const {
+  const auto it = jointIndex_.find(name);
+  return it == jointIndex_.end() ? -1 : it->second;
+}
+
+std::vector<std::string> UrdfModel::linksContaining(const std::string& part) const {
+  std::vector<std::string> found;
+  const std::string p = lower(part);
+  for (const LinkDesc& link : links_) {
+    if (lower(link.name).find(p) != std::string::npos) found.push_back(link.name);
+  }
+  return found;
+}
+
+}  // namespace cape::character

@@ -1,0 +1,172 @@
+// A small well-formedness check for XML, run before urdfdom so that a broken file is reported as broken XML,
+// with a line number, rather than as whatever urdfdom's parser happened to print. It checks structure only:
+// balanced and matching tags, quoted attributes, one root element, nothing but white space outside it.
+#include "cape/character/Urdf.h"
+
+#include <cctype>
+#include <string>
+#include <vector>
+
+namespace cape::character {
+namespace {
+
+class XmlScanner {
+ public:
+  explicit XmlScanner(const std::string& text) : s_(text) {}
+
+  bool run(std::string& message) {
+    if (s_.compare(0, 3, "\xEF\xBB\xBF") == 0) i_ = 3;  // UTF-8 byte order mark
+    bool sawRoot = false;
+    while (i_ < s_.size()) {
+      if (s_[i_] != '<') {
+        if (stack_.empty() && !std::isspace(static_cast<unsigned char>(s_[i_]))) {
+          return fail(message, "text outside the root element");
+        }
+        advance(1);
+        continue;
+      }
+      if (startsWith("<!--")) {
+        if (!skipPast("-->")) return fail(message, "unterminated comment");
+      } else if (startsWith("<![CDATA[")) {
+        if (stack_.empty()) return fail(message, "CDATA outside the root element");
+        if (!skipPast("]]>")) return fail(message, "unterminated CDATA section");
+      } else if (startsWith("<?")) {
+        if (!skipPast("?>")) return fail(message, "unterminated processing instruction");
+      } else if (startsWith("<!")) {
+        if (!skipDeclaration()) return fail(message, "unterminated <! declaration");
+      } else if (startsWith("</")) {
+        advance(2);
+        const std::string name = readName();
+        if (name.empty()) return fail(message, "end tag without a name");
+        skipSpace();
+        if (i_ >= s_.size() || s_[i_] != '>') return fail(message, "end tag </" + name + "> not closed by '>'");
+        advance(1);
+        if (stack_.empty()) return fail(message, "end tag </" + name + "> without a start tag");
+        if (stack_.back() != name) {
+          return fail(message, "end tag </" + name + "> does not match <" + stack_.back() + ">");
+        }
+        stack_.pop_back();
+      } else {
+        advance(1);
+        const std::string name = readName();
+        if (name.empty()) return fail(message, "'<' not followed by a tag name");
+        if (stack_.empty() && sawRoot) return fail(message, "a second root element <" + name + ">");
+        sawRoot = true;
+        bool selfClosing = false;
+        if (!readAttributes(selfClosing, message)) return false;
+        if (!selfClosing) stack_.push_back(name);
+      }
+    }
+    if (!stack_.empty()) return fail(message, "end of text inside <" + stack_.back() + "> (not closed)");
+    if (!sawRoot) return fail(message, "no root element (empty document)");
+    return true;
+  }
+
+ private:
+  bool startsWith(const char* prefix) const { return s_.compare(i_, std::char_traits<char>::length(prefix), prefix) == 0; }
+
+  void advance(std::size_t n) {
+    for (std::size_t k = 0; k < n && i_ < s_.size(); ++k, ++i_) {
+      if (s_[i_] == '\n') ++line_;
+    }
+  }
+
+  bool skipPast(const char* end) {
+    const std::size_t at = s_.find(end, i_);
+    if (at == std::string::npos) return false;
+    advance(at + std::char_traits<char>::length(end) - i_);
+    return true;
+  }
+
+  // <!DOCTYPE ...> with an optional internal subset in [ ... ].
+  bool skipDeclaration() {
+    int bracket = 0;
+    while (i_ < s_.size()) {
+      const char c = s_[i_];
+      advance(1);
+      if (c == '[') ++bracket;
+      if (c == ']') --bracket;
+      if (c == '>' && bracket <= 0) return true;
+    }
+    return false;
+  }
+
+  static bool isNameChar(char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == ':' || c == '-' || c == '.' ||
+           static_cast<unsigned char>(c) >= 0x80;
+  }
+
+  std::string readName() {
+    const std::size_t start = i_;
+    if (i_ < s_.size() && (std::isdigit(static_cast<unsigned char>(s_[i_])) || s_[i_] == '-' || s_[i_] == '.')) {
+      return std::string();
+    }
+    while (i_ < s_.size() && isNameChar(s_[i_])) ++i_;
+    return s_.substr(start, i_ - start);
+  }
+
+  void skipSpace() {
+    while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) advance(1);
+  }
+
+  bool readAttributes(bool& selfClosing, std::string& message) {
+    std::vector<std::string> seen;
+    for (;;) {
+      const std::size_t before = i_;
+      skipSpace();
+      if (i_ >= s_.size()) return fail(message, "end of text inside a start tag");
+      if (s_[i_] == '>') {
+        advance(1);
+        return true;
+      }
+      if (s_[i_] == '/') {
+        advance(1);
+        if (i_ >= s_.size() || s_[i_] != '>') return fail(message, "'/' in a start tag not followed by '>'");
+        advance(1);
+        selfClosing = true;
+        return true;
+      }
+      if (i_ == before) return fail(message, "attributes must be separated by white space");
+      const std::string attr = readName();
+      if (attr.empty()) return fail(message, std::string("unexpected '") + s_[i_] + "' in a start tag");
+      for (const std::string& other : seen) {
+        if (other == attr) return fail(message, "attribute '" + attr + "' given twice");
+      }
+      seen.push_back(attr);
+      skipSpace();
+      if (i_ >= s_.size() || s_[i_] != '=') return fail(message, "attribute '" + attr + "' without '=' and a value");
+      advance(1);
+      skipSpace();
+      if (i_ >= s_.size() || (s_[i_] != '"' && s_[i_] != '\'')) {
+        return fail(message, "value of attribute '" + attr + "' is not quoted");
+      }
+      const char quote = s_[i_];
+      advance(1);
+      while (i_ < s_.size() && s_[i_] != quote) {
+        if (s_[i_] == '<') return fail(message, "'<' inside the value of attribute '" + attr + "'");
+        advance(1);
+      }
+      if (i_ >= s_.size()) return fail(message, "unterminated value of attribute '" + attr + "'");
+      advance(1);
+    }
+  }
+
+  bool fail(std::string& message, const std::string& what) const {
+    message = "line " + std::to_string(line_) + ": " + what;
+    return false;
+  }
+
+  const std::string& s_;
+  std::size_t i_ = 0;
+  int line_ = 1;
+  std::vector<std::string> stack_;
+};
+
+}  // namespace
+
+bool checkXmlWellFormed(const std::string& text, std::string& message) {
+  XmlScanner scanner(text);
+  return scanner.run(message);
+}
+
+}  // namespace cape::character
