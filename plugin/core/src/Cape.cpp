@@ -80,6 +80,21 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
     for (int k = 0; k < 3; ++k) particleArea_[tri[t + static_cast<std::size_t>(k)]] += third;
   }
   colliderEnd_.reserve(64);
+  // Self-collision scratch: a hash of at least twice as many buckets as particles (a power of two).
+  std::uint32_t buckets = 1;
+  while (buckets < 2 * static_cast<std::uint32_t>(n)) buckets <<= 1;
+  hashStart_.assign(buckets + 1, 0u);
+  hashEntries_.assign(8 * fabric_->triangleCount(), 0u);
+  triangleBoxes_.assign(6 * fabric_->triangleCount(), 0.0f);
+  stepMotion_ = Points::Zero(n, 3);
+  stepMotionNorm_ = Eigen::VectorXf::Zero(n);
+  selfContacts_.reserve(static_cast<std::size_t>(32 * n));
+  {
+    const SpringSet& structural = fabric_->springs(SpringFamily::Structural);
+    double sum = 0.0;
+    for (float l : structural.restLength) sum += l;
+    meanSpacing_ = structural.size() > 0 ? static_cast<float>(sum / static_cast<double>(structural.size())) : 0.01f;
+  }
   contacts_.reserve(static_cast<std::size_t>(4 * n));
   distance2_.resize(n);
   candidates_.reserve(static_cast<std::size_t>(n));
@@ -164,6 +179,9 @@ void Cape::step(float dt, ColliderSpan colliders) {
   // far slower than a frame.
   if (settings_.wind.model != WindSettings::Model::None)
     windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt), airVelocity_);
+  // Self-contacts are found once per step, from where the cape is now, and kept through its substeps.
+  if (settings_.selfCollision && settings_.integrator == Integrator::Xpbd) findSelfContacts(dt);
+  // Self-contacts are found once per step, from where the cape is now, and kept through its substeps.
   for (int k = 0; k < substeps; ++k) {
     const float s0 = static_cast<float>(k) / static_cast<float>(substeps);
     const float s1 = static_cast<float>(k + 1) / static_cast<float>(substeps);
@@ -233,6 +251,7 @@ void Cape::stepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
   for (int it = 0; it < settings_.iterations; ++it) {
     if (settings_.useTethers) solveTethers();
     solveSprings(h);
+    if (settings_.selfCollision) solveSelfContacts();
   }
   collide(h, s0, s1, colliders, false);
   // A particle wedged where two colliders meet (a shoulder sphere poking out of the torso box) is pushed out

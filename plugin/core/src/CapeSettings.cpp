@@ -48,6 +48,8 @@ Status CapeSettings::validate() const {
   if (!finiteNonNegative(collisionThickness))
     return Status::error("CapeSettings: collisionThickness must be finite and >= 0 (m)");
   if (!finiteNonNegative(friction)) return Status::error("CapeSettings: friction must be finite and >= 0");
+  if (selfCollision && !(std::isfinite(selfCollisionThickness) && selfCollisionThickness > 0.0f))
+    return Status::error("CapeSettings: selfCollisionThickness must be finite and > 0 (m)");
   if (substeps < 1 || substeps > 1000) return Status::error("CapeSettings: substeps must be in 1..1000");
   if (iterations < 1 || iterations > 1000) return Status::error("CapeSettings: iterations must be in 1..1000");
   if (!gravity.allFinite()) return Status::error("CapeSettings: gravity must be finite");

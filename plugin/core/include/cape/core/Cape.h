@@ -63,6 +63,9 @@ class Cape {
     std::uint32_t collider;
   };
 
+  /// Self-contacts found for the last step (diagnostics and benchmarks).
+  std::size_t selfContactCount() const { return selfContacts_.size(); }
+
   /// Sum over particles of kinetic and gravitational potential energy plus spring (Hooke) energy, J.
   double energy() const;
 
@@ -76,6 +79,8 @@ class Cape {
   void solveSprings(float h);
   void solveTethers();
   void accumulateExternalAcceleration();
+  void findSelfContacts(float dt);
+  void solveSelfContacts();
 
   FabricPtr fabric_;
   CapeSettings settings_;
@@ -95,6 +100,22 @@ class Cape {
   std::vector<Contact> contacts_;   ///< Contacts of the substep's collision pass.
   Eigen::ArrayXf distance2_;        ///< Broad-phase scratch, one per particle.
   std::vector<std::uint32_t> candidates_;  ///< Broad-phase scratch.
+
+  /// A predictive self-contact (Lewin 2018): a particle near a triangle it does not belong to, found at the
+  /// start of the step, with the side of the triangle it was on then (+1, -1, or 0 while its nearest point
+  /// is on the triangle's boundary). The solver keeps it on that side, at least the thickness away.
+  struct SelfContact {
+    std::uint32_t particle;
+    std::uint32_t triangle;
+    float side;
+  };
+  std::vector<SelfContact> selfContacts_;
+  std::vector<std::uint32_t> hashStart_;     ///< Spatial hash: bucket offsets (buckets + 1).
+  std::vector<std::uint32_t> hashEntries_;   ///< Spatial hash: triangles sorted by bucket.
+  std::vector<float> triangleBoxes_;         ///< Grown bounding box of each triangle (lo xyz, hi xyz), m.
+  Points stepMotion_;                        ///< Predicted displacement over the step, less the mean, m.
+  Eigen::VectorXf stepMotionNorm_;           ///< |stepMotion_| per particle, m.
+  float meanSpacing_ = 0.0f;                 ///< Mean structural rest length, m (sizes the hash cells).
 };
 
 }  // namespace cape

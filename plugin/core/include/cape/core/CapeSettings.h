@@ -65,7 +65,12 @@ struct CapeSettings {
   float timeStep = 1.0f / 60.0f;
 
   WindSettings wind;
-  bool selfCollision = false;  ///< Keep the cape from passing through itself.
+  /// Keep the cape from passing through itself: particle-triangle contacts found through a spatial hash at
+  /// the start of every step and kept on their side through its substeps (predictive contacts, Lewin 2018).
+  bool selfCollision = false;
+  /// Distance kept between a particle and any triangle it does not belong to, m (> 0 when self-collision is
+  /// on). About the cloth's real thickness; well under the particle spacing.
+  float selfCollisionThickness = 0.005f;
 
   /// The seed's reference set-up: explicit springs, soft, 4 substeps of 0.00875 s per 0.035 s frame.
   static CapeSettings seed();

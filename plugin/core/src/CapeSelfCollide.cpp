@@ -1,0 +1,214 @@
+// Self-collision: predictive particle-triangle contacts (Lewin 2018, "Cloth Self Collision with Predictive
+// Contacts", GDC). At the start of a step every particle that could come within the thickness of a triangle
+// it does not belong to during the step is paired with it, and the side of the triangle it is on is noted.
+// The substeps then keep the particle on that side, at least the thickness away: as long as the cape starts
+// the step free of intersections, no particle can pass through a triangle, however fast the fold.
+#include "cape/core/Cape.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cape {
+
+namespace {
+
+/// The point of triangle (a, b, c) nearest to p, as barycentric weights (wa, wb, wc), and whether it lies
+/// inside the face (true) or on its boundary. Voronoi regions of the triangle's vertices, edges and face.
+struct Nearest {
+  float wa, wb, wc;
+  bool inFace;
+};
+
+Nearest nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0f && d2 <= 0.0f) return {1, 0, 0, false};
+  const Vec3 bp = p - b;
+  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0f && d4 <= d3) return {0, 1, 0, false};
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
+    const float v = d1 / (d1 - d3);
+    return {1 - v, v, 0, false};
+  }
+  const Vec3 cp = p - c;
+  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0f && d5 <= d6) return {0, 0, 1, false};
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
+    const float w = d2 / (d2 - d6);
+    return {1 - w, 0, w, false};
+  }
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
+    const float w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0, 1 - w, w, false};
+  }
+  const float denom = va + vb + vc;
+  if (!(std::fabs(denom) > 0.0f)) return {1, 0, 0, false};  // degenerate triangle: treat as its first corner
+  const float v = vb / denom, w = vc / denom;
+  return {1 - v - w, v, w, true};
+}
+
+/// Barycentric weights of p's projection onto the plane of (a, b, c), unclamped; false if degenerate.
+bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float& wa, float& wb, float& wc) {
+  const Vec3 v0 = b - a, v1 = c - a, v2 = p - a;
+  const float d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
+  const float den = d00 * d11 - d01 * d01;
+  if (!(den > 1e-20f)) return false;
+  wb = (d11 * d20 - d01 * d21) / den;
+  wc = (d00 * d21 - d01 * d20) / den;
+  wa = 1.0f - wb - wc;
+  return true;
+}
+
+/// A particle over a triangle grown by this fraction of itself (in barycentric terms) keeps its side: the
+/// grown triangles of a vertex's ring overlap, so a particle heading straight for a vertex or an edge of the
+/// other layer (two halves of a folded grid line up exactly) is caught as surely as one heading for a face.
+constexpr float kFaceMargin = 0.25f;
+
+inline bool overFace(float wa, float wb, float wc) { return wa >= -kFaceMargin && wb >= -kFaceMargin && wc >= -kFaceMargin; }
+
+inline Vec3 at(const Points& x, std::uint32_t i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
+
+inline std::uint32_t bucketOf(int ix, int iy, int iz, std::uint32_t mask) {
+  const std::uint32_t h = static_cast<std::uint32_t>(ix) * 73856093u ^ static_cast<std::uint32_t>(iy) * 19349663u ^
+                          static_cast<std::uint32_t>(iz) * 83492791u;
+  return h & mask;
+}
+
+}  // namespace
+
+void Cape::findSelfContacts(float dt) {
+  selfContacts_.clear();
+  const Points& x = state_.positions;
+  const Eigen::Index n = x.rows();
+  const float thickness = settings_.selfCollisionThickness;
+
+  // How far each particle may move in this step, less the motion the whole cape shares (walking carries
+  // every particle 2 cm per frame, which brings no two of them closer): v dt + g dt^2 / 2 (pinned particles
+  // move at the velocity their pin gave them).
+  stepMotion_ = state_.velocities * dt;
+  for (int c = 0; c < 3; ++c) stepMotion_.col(c) += (0.5f * dt * dt * settings_.gravity[c]) * freeMask_;
+  const Eigen::RowVector3f mean = stepMotion_.colwise().mean();
+  stepMotion_.rowwise() -= mean;
+  Eigen::VectorXf& motion = stepMotionNorm_;
+  motion = stepMotion_.rowwise().norm();  // same size every step: no allocation
+  const float maxMotion = motion.maxCoeff();
+
+  // A pair can close in by at most their relative motion; the solver's own corrections (springs, collisions)
+  // add some more, which one more thickness and a quarter of the spacing allow for.
+  const float slack = thickness + 0.25f * meanSpacing_;
+
+  // Bin the triangles, each grown by how far a particle could come at it, into the cells of a hashed grid;
+  // then each particle looks in its own cell only. Cells twice the spacing: a triangle spans one or two per
+  // axis.
+  const std::vector<std::uint32_t>& tri = fabric_->triangles();
+  const std::size_t triangles = tri.size() / 3;
+  const float cell = 2.0f * meanSpacing_;
+  const float invCell = 1.0f / cell;
+  const std::uint32_t buckets = static_cast<std::uint32_t>(hashStart_.size() - 1);
+  const std::uint32_t mask = buckets - 1;
+  auto cellOf = [invCell](float v) { return static_cast<int>(std::floor(v * invCell)); };
+  std::fill(hashStart_.begin(), hashStart_.end(), 0u);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
+    const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
+    const float reach = thickness + slack + std::max({motion[ia], motion[ib], motion[ic]}) + maxMotion;
+    const Vec3 lo = a.cwiseMin(b).cwiseMin(c).array() - reach;
+    const Vec3 hi = a.cwiseMax(b).cwiseMax(c).array() + reach;
+    float* box = &triangleBoxes_[6 * t];
+    for (int k = 0; k < 3; ++k) {
+      box[k] = lo[k];
+      box[3 + k] = hi[k];
+    }
+    for (int ix = cellOf(lo.x()); ix <= cellOf(hi.x()); ++ix)
+      for (int iy = cellOf(lo.y()); iy <= cellOf(hi.y()); ++iy)
+        for (int iz = cellOf(lo.z()); iz <= cellOf(hi.z()); ++iz) ++hashStart_[bucketOf(ix, iy, iz, mask) + 1];
+  }
+  for (std::uint32_t b = 0; b < buckets; ++b) hashStart_[b + 1] += hashStart_[b];  // [b] = start of bucket b
+  if (hashEntries_.size() < hashStart_[buckets]) hashEntries_.resize(hashStart_[buckets]);  // grows rarely
+  // Fill in triangle order (deterministic), each bucket's start serving as its cursor...
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const float* box = &triangleBoxes_[6 * t];
+    for (int ix = cellOf(box[0]); ix <= cellOf(box[3]); ++ix)
+      for (int iy = cellOf(box[1]); iy <= cellOf(box[4]); ++iy)
+        for (int iz = cellOf(box[2]); iz <= cellOf(box[5]); ++iz)
+          hashEntries_[hashStart_[bucketOf(ix, iy, iz, mask)]++] = static_cast<std::uint32_t>(t);
+  }
+  // ...which leaves [b] at the end of bucket b: shift back so bucket b is [hashStart_[b], hashStart_[b + 1]).
+  for (std::uint32_t b = buckets; b > 0; --b) hashStart_[b] = hashStart_[b - 1];
+  hashStart_[0] = 0;
+
+  for (Eigen::Index qi = 0; qi < n; ++qi) {
+    const std::uint32_t q = static_cast<std::uint32_t>(qi);
+    const Vec3 p = at(x, q);
+    const std::uint32_t bucket = bucketOf(cellOf(p.x()), cellOf(p.y()), cellOf(p.z()), mask);
+    std::uint32_t previous = ~0u;
+    for (std::uint32_t e = hashStart_[bucket]; e < hashStart_[bucket + 1]; ++e) {
+      const std::uint32_t t = hashEntries_[e];
+      if (t == previous) continue;  // two cells of one triangle hashed to this bucket: entries are adjacent
+      previous = t;
+      const float* box = &triangleBoxes_[6 * t];
+      if (p.x() < box[0] || p.y() < box[1] || p.z() < box[2] || p.x() > box[3] || p.y() > box[4] || p.z() > box[5]) continue;
+      const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
+      if (q == ia || q == ib || q == ic) continue;
+      const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
+      const Nearest w = nearestOnTriangle(p, a, b, c);
+      const Vec3 nearest = w.wa * a + w.wb * b + w.wc * c;
+      // How much closer the two may come: the particle's motion relative to the triangle's corners.
+      const Vec3 mq = stepMotion_.row(q).transpose();
+      const float closing = std::max({(mq - stepMotion_.row(ia).transpose()).norm(), (mq - stepMotion_.row(ib).transpose()).norm(),
+                                      (mq - stepMotion_.row(ic).transpose()).norm()});
+      if ((p - nearest).norm() > thickness + slack + closing) continue;
+      float side = 0.0f, wa, wb, wc;
+      if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc))
+        side = (b - a).cross(c - a).dot(p - a) >= 0.0f ? 1.0f : -1.0f;
+      selfContacts_.push_back({q, t, side});
+    }
+  }
+}
+
+void Cape::solveSelfContacts() {
+  Points& x = state_.positions;
+  const float* w = state_.inverseMasses.data();
+  const float thickness = settings_.selfCollisionThickness;
+  const std::vector<std::uint32_t>& tri = fabric_->triangles();
+  for (SelfContact& k : selfContacts_) {
+    const std::uint32_t ia = tri[3 * k.triangle], ib = tri[3 * k.triangle + 1], ic = tri[3 * k.triangle + 2];
+    const Vec3 p = at(x, k.particle), a = at(x, ia), b = at(x, ib), c = at(x, ic);
+    const Nearest bary = nearestOnTriangle(p, a, b, c);
+    Vec3 normal;
+    float distance;
+    float wa, wb, wc;
+    if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc)) {
+      // Over the (grown) face: keep to the side the particle started the step on, or first came over it from.
+      Vec3 faceNormal = (b - a).cross(c - a);
+      const float len = faceNormal.norm();
+      if (!(len > 0.0f)) continue;
+      faceNormal /= len;
+      if (k.side == 0.0f) k.side = faceNormal.dot(p - a) >= 0.0f ? 1.0f : -1.0f;
+      normal = k.side * faceNormal;
+      distance = normal.dot(p - a);  // negative: it has crossed, and is brought back
+      // The correction goes to the corners by the weights of the nearest point of the real triangle.
+    } else {
+      // Beside an edge or a corner: a plain distance, no side to keep.
+      const Vec3 d = p - (bary.wa * a + bary.wb * b + bary.wc * c);
+      distance = d.norm();
+      if (!(distance > 1e-9f)) continue;
+      normal = d / distance;
+    }
+    if (distance >= thickness) continue;
+    // PBD point-triangle constraint C = n . (p - sum w_k x_k) - thickness >= 0, gradients n and -w_k n.
+    const float invP = w[k.particle], invA = w[ia], invB = w[ib], invC = w[ic];
+    const float denominator = invP + bary.wa * bary.wa * invA + bary.wb * bary.wb * invB + bary.wc * bary.wc * invC;
+    if (!(denominator > 0.0f)) continue;
+    const Vec3 step = ((thickness - distance) / denominator) * normal;
+    x.row(k.particle) += invP * step.transpose();
+    x.row(ia) -= (invA * bary.wa) * step.transpose();
+    x.row(ib) -= (invB * bary.wb) * step.transpose();
+    x.row(ic) -= (invC * bary.wc) * step.transpose();
+  }
+}
+
+}  // namespace cape
