@@ -1,0 +1,90 @@
+// A procedural walking (or running) gait: a closed-form function of time, so any frame can be posed directly,
+// with no state and no dependence on the step size.
+//
+// Root motion. The character frame (origin on the ground between the feet, facing -Z at yaw 0) follows the
+// canonical scenes exactly: for a scene, or for any gait that does not turn, it is the core's
+// cape::motionAt(MotionDesc, t) (shared/SCENARIOS.md: walk at 1.4 m/s, sprint-turn at 5 m/s with a 180 degree
+// turn in the last 0.5 s of every 2 s), with the torso bob added to the root height, as the simple body does.
+// A gait with a constant turn rate w follows the exact arc: yaw = w t, and with forward = (-sin yaw, 0, -cos yaw),
+// position = (v/w (cos w t - 1), 0, -v/w sin w t).
+//
+// Joint angles, anatomical (see JointMapping.h), with phase p = 2 pi f t:
+//   hip       left  A sin p                        right  -A sin p   (SCENARIOS.md: A = 0.5236 rad)
+//   knee      left  k0 + K max(0, cos p)^2         right  k0 + K max(0, -cos p)^2
+//             (the knee bends while its leg swings forward, most at mid-swing; C1-smooth)
+//   ankle     a (knee - hip): a = 1 keeps the foot level, a < 1 lets it follow the shin a little
+//   shoulder  left  -S sin p                       right  S sin p    (arms swing against the legs)
+//   elbow     left  E0 + E1 (1 - sin p) / 2        right  E0 + E1 (1 + sin p) / 2 (more bent when forward)
+// then joint position = sign * angle, clamped to the joint's limits. Every angle is a function of p alone, so
+// the joint trajectories repeat every 1/f seconds (and the bob too when its frequency is a multiple of f).
+// With f = 0 (standing) every angle is 0: the rest pose.
+#pragma once
+
+#include "cape/character/JointMapping.h"
+#include "cape/character/Skeleton.h"
+
+#include "cape/core/Scene.h"
+
+#include <array>
+
+namespace cape::character {
+
+struct GaitParams {
+  double speed = 0.0;          ///< m/s along the heading
+  double turnRate = 0.0;       ///< rad/s about world +Y (positive turns to the character's left)
+  double stepFrequency = 0.0;  ///< Hz: full leg cycles per second (one left and one right step), SCENARIOS' "legs swing at"
+  double bobAmplitude = 0.0;   ///< m, half the peak-to-peak torso bob (the whole body rises and falls)
+  double bobFrequency = 0.0;   ///< Hz, usually 2 * stepFrequency (one bob per step)
+  double hipAmplitude = 0.5236;  ///< rad, A above
+  double kneeStance = 0.05;      ///< rad, k0: the knee's least bend
+  double kneeSwing = 0.8;        ///< rad, K: extra bend at mid-swing
+  double ankleFollow = 0.8;      ///< a in [0, 1]
+  double armSwing = 0.35;        ///< rad, S
+  double elbowBase = 0.5;        ///< rad, E0
+  double elbowSwing = 0.2;       ///< rad, E1
+
+  /// Amplitudes that look right at a speed: knees and elbows bend more, arms swing wider as it speeds up
+  /// (walk at 1.4 m/s: K 0.81, S 0.36, E0 0.53; sprint at 5 m/s: K 1.35, S 0.65, E0 1.25). Bob 1.5 cm at
+  /// twice the step frequency when moving.
+  static GaitParams forSpeed(double speed, double stepFrequency, double turnRate = 0.0);
+};
+
+/// The character frame at a time: world position on the ground (m), yaw about +Y (rad), bob (m).
+struct RootPose {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double yaw = 0.0;
+  double bob = 0.0;
+  /// Where the URDF origin goes: position raised by the bob (for a core motion, summed in float exactly as
+  /// cape::BodyPose::frame() does, so the simple body and the URDF body share their frame to the last bit).
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+};
+
+class Gait {
+ public:
+  /// A gait of its own: root motion from speed and turn rate (exactly motionAt's straight line when the turn
+  /// rate is 0).
+  explicit Gait(const GaitParams& params);
+  /// A canonical scene's motion (cape::MotionDesc::forScene): hang, walk, sprint-turn, wind, crowd.
+  static Gait forScene(cape::SceneKind kind);
+  /// Any core motion description; amplitudes from GaitParams::forSpeed.
+  static Gait fromMotion(const cape::MotionDesc& motion);
+
+  const GaitParams& params() const { return params_; }
+  /// s after which the joint angles repeat (1 / stepFrequency); 0 when standing still.
+  double period() const { return params_.stepFrequency > 0.0 ? 1.0 / params_.stepFrequency : 0.0; }
+
+  RootPose rootAt(double t) const;
+  /// Anatomical angles of every role at time t (rad), indexed by GaitRole.
+  std::array<double, kGaitRoleCount> anglesAt(double t) const;
+  /// Poses `skeleton` at time t: the root (bob included, `offset` added: m, in the world, for characters side by
+  /// side) and every mapped joint; unmapped joints and joints of no role are left where they are. No allocation.
+  void apply(double t, const JointMapping& mapping, Skeleton& skeleton,
+             const Eigen::Vector3d& offset = Eigen::Vector3d::Zero()) const;
+
+ private:
+  GaitParams params_;
+  bool useMotion_ = false;  ///< root from cape::motionAt(motion_, t)
+  cape::MotionDesc motion_;
+};
+
+}  // namespace cape::character
