@@ -1,6 +1,8 @@
 // Loading a URDF with urdfdom into the plain data of Urdf.h, with every failure turned into a Status.
 #include "cape/character/Urdf.h"
 
+#include "XmlOutline.h"
+
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -98,6 +100,61 @@ bool contains(const std::string& text, const char* part) { return text.find(part
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
+}
+
+// urdfdom links own their children through shared pointers: fed a cycle, the links own each other and are never
+// freed (LeakSanitizer says so), whether urdfdom then rejects the model or not. So the joint graph is checked here
+// first, on the XML outline: each link the child of at most one joint, and no loop of parents.
+Status checkJointGraph(const std::vector<XmlElement>& outline) {
+  if (outline.empty() || outline[0].name != "robot") return Status::success();  // urdfdom will say what is wrong
+  std::unordered_map<std::string, std::string> parentOf;  // child link -> parent link
+  std::unordered_map<std::string, std::string> jointOf;   // child link -> joint
+  for (std::size_t i = 1; i < outline.size(); ++i) {
+    if (outline[i].name != "joint" || outline[i].parent != 0) continue;
+    const std::string* parent = nullptr;
+    const std::string* child = nullptr;
+    for (std::size_t k = i + 1; k < outline.size() && outline[k].parent >= static_cast<int>(i); ++k) {
+      if (outline[k].parent != static_cast<int>(i)) continue;
+      if (outline[k].name == "parent") parent = outline[k].attribute("link");
+      if (outline[k].name == "child") child = outline[k].attribute("link");
+    }
+    if (!parent || !child) continue;  // urdfdom reports the incomplete joint
+    const std::string* name = outline[i].attribute("name");
+    const std::string joint = name ? *name : std::string("?");
+    if (parentOf.count(*child) != 0) {
+      return Status::error(ErrorCode::NotATree, "link '" + *child + "' is the child of two joints, '" +
+                                                    jointOf[*child] + "' and '" + joint + "'");
+    }
+    parentOf[*child] = *parent;
+    jointOf[*child] = joint;
+  }
+  // Every loop of parents passes through each of its links, so starting from every link finds every loop.
+  for (const auto& entry : parentOf) {
+    const std::string& start = entry.first;
+    std::string path = start;
+    std::string at = start;
+    for (std::size_t steps = 0; steps <= parentOf.size(); ++steps) {
+      const auto it = parentOf.find(at);
+      if (it == parentOf.end()) break;
+      at = it->second;
+      path += " -> " + at;
+      if (at == start) {
+        return Status::error(ErrorCode::NotATree, "joints form a cycle (child -> parent): " + path);
+      }
+    }
+  }
+  return Status::success();
+}
+
+// Breaks urdfdom's parent-to-child ownership so that the parsed model is freed even if it holds a loop.
+void release(urdf::ModelInterfaceSharedPtr& model) {
+  if (!model) return;
+  for (auto& entry : model->links_) {
+    if (!entry.second) continue;
+    entry.second->child_links.clear();
+    entry.second->child_joints.clear();
+  }
+  model.reset();
 }
 
 }  // namespace
@@ -262,10 +319,13 @@ struct UrdfModelBuilder {
 UrdfLoadResult UrdfModel::fromString(const std::string& xml) {
   UrdfLoadResult result;
   std::string xmlError;
-  if (!checkXmlWellFormed(xml, xmlError)) {
+  std::vector<XmlElement> outline;
+  if (!scanXml(xml, xmlError, &outline)) {
     result.status = Status::error(ErrorCode::MalformedXml, "URDF is not well-formed XML: " + xmlError);
     return result;
   }
+  result.status = checkJointGraph(outline);
+  if (!result.status.ok()) return result;
 
   CapturedConsole console;
   urdf::ModelInterfaceSharedPtr parsed;
@@ -310,6 +370,7 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xml) {
   } catch (const std::exception& e) {
     result.status = Status::error(ErrorCode::InvalidModel, std::string("URDF could not be read: ") + e.what());
   }
+  release(parsed);
   if (result.status.ok()) result.model = std::move(model);
   return result;
 }

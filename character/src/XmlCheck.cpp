@@ -1,6 +1,8 @@
 // A small well-formedness check for XML, run before urdfdom so that a broken file is reported as broken XML,
 // with a line number, rather than as whatever urdfdom's parser happened to print. It checks structure only:
 // balanced and matching tags, quoted attributes, one root element, nothing but white space outside it.
+#include "XmlOutline.h"
+
 #include "cape/character/Urdf.h"
 
 #include <cctype>
@@ -12,7 +14,7 @@ namespace {
 
 class XmlScanner {
  public:
-  explicit XmlScanner(const std::string& text) : s_(text) {}
+  XmlScanner(const std::string& text, std::vector<XmlElement>* outline) : s_(text), outline_(outline) {}
 
   bool run(std::string& message) {
     if (s_.compare(0, 3, "\xEF\xBB\xBF") == 0) i_ = 3;  // UTF-8 byte order mark
@@ -46,15 +48,24 @@ class XmlScanner {
           return fail(message, "end tag </" + name + "> does not match <" + stack_.back() + ">");
         }
         stack_.pop_back();
+        open_.pop_back();
       } else {
         advance(1);
         const std::string name = readName();
         if (name.empty()) return fail(message, "'<' not followed by a tag name");
         if (stack_.empty() && sawRoot) return fail(message, "a second root element <" + name + ">");
         sawRoot = true;
+        XmlElement element;
+        element.name = name;
+        element.parent = open_.empty() ? -1 : open_.back();
         bool selfClosing = false;
-        if (!readAttributes(selfClosing, message)) return false;
-        if (!selfClosing) stack_.push_back(name);
+        if (!readAttributes(selfClosing, element.attributes, message)) return false;
+        const int index = outline_ ? static_cast<int>(outline_->size()) : -1;
+        if (outline_) outline_->push_back(std::move(element));
+        if (!selfClosing) {
+          stack_.push_back(name);
+          open_.push_back(index);
+        }
       }
     }
     if (!stack_.empty()) return fail(message, "end of text inside <" + stack_.back() + "> (not closed)");
@@ -109,8 +120,8 @@ class XmlScanner {
     while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) advance(1);
   }
 
-  bool readAttributes(bool& selfClosing, std::string& message) {
-    std::vector<std::string> seen;
+  bool readAttributes(bool& selfClosing, std::vector<std::pair<std::string, std::string>>& attributes,
+                      std::string& message) {
     for (;;) {
       const std::size_t before = i_;
       skipSpace();
@@ -129,10 +140,9 @@ class XmlScanner {
       if (i_ == before) return fail(message, "attributes must be separated by white space");
       const std::string attr = readName();
       if (attr.empty()) return fail(message, std::string("unexpected '") + s_[i_] + "' in a start tag");
-      for (const std::string& other : seen) {
-        if (other == attr) return fail(message, "attribute '" + attr + "' given twice");
+      for (const auto& other : attributes) {
+        if (other.first == attr) return fail(message, "attribute '" + attr + "' given twice");
       }
-      seen.push_back(attr);
       skipSpace();
       if (i_ >= s_.size() || s_[i_] != '=') return fail(message, "attribute '" + attr + "' without '=' and a value");
       advance(1);
@@ -142,11 +152,13 @@ class XmlScanner {
       }
       const char quote = s_[i_];
       advance(1);
+      const std::size_t valueStart = i_;
       while (i_ < s_.size() && s_[i_] != quote) {
         if (s_[i_] == '<') return fail(message, "'<' inside the value of attribute '" + attr + "'");
         advance(1);
       }
       if (i_ >= s_.size()) return fail(message, "unterminated value of attribute '" + attr + "'");
+      attributes.emplace_back(attr, s_.substr(valueStart, i_ - valueStart));
       advance(1);
     }
   }
@@ -159,14 +171,26 @@ class XmlScanner {
   const std::string& s_;
   std::size_t i_ = 0;
   int line_ = 1;
-  std::vector<std::string> stack_;
+  std::vector<std::string> stack_;  ///< names of the open elements
+  std::vector<int> open_;            ///< their indices in *outline_ (-1 without an outline)
+  std::vector<XmlElement>* outline_;
 };
 
 }  // namespace
 
-bool checkXmlWellFormed(const std::string& text, std::string& message) {
-  XmlScanner scanner(text);
+bool scanXml(const std::string& text, std::string& message, std::vector<XmlElement>* outline) {
+  if (outline) outline->clear();
+  XmlScanner scanner(text, outline);
   return scanner.run(message);
+}
+
+bool checkXmlWellFormed(const std::string& text, std::string& message) { return scanXml(text, message, nullptr); }
+
+const std::string* XmlElement::attribute(const std::string& key) const {
+  for (const auto& [k, v] : attributes) {
+    if (k == key) return &v;
+  }
+  return nullptr;
 }
 
 }  // namespace cape::character

@@ -165,7 +165,21 @@ TEST(Urdf, CyclesAreRejected) {
   EXPECT_EQ(pure.status.code(), ErrorCode::NotATree) << pure.status.message();
   const UrdfLoadResult beside = UrdfModel::fromString("<robot name='c'><link name='root'/>" + cycle + "</robot>");
   EXPECT_EQ(beside.status.code(), ErrorCode::NotATree) << beside.status.message();
-  EXPECT_NE(beside.status.message().find("a, b"), std::string::npos) << beside.status.message();
+  const std::string& msg = beside.status.message();
+  EXPECT_TRUE(msg.find("a -> b -> a") != std::string::npos || msg.find("b -> a -> b") != std::string::npos) << msg;
+}
+
+TEST(Urdf, TwoParentsOrTwoRootsAreNotATree) {
+  const UrdfLoadResult twoParents = UrdfModel::fromString(R"(<robot name="t">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="ac" type="fixed"><parent link="a"/><child link="c"/></joint>
+    <joint name="bc" type="fixed"><parent link="b"/><child link="c"/></joint></robot>)");
+  EXPECT_EQ(twoParents.status.code(), ErrorCode::NotATree) << twoParents.status.message();
+  EXPECT_NE(twoParents.status.message().find("'c'"), std::string::npos) << twoParents.status.message();
+  const UrdfLoadResult twoRoots = UrdfModel::fromString(R"(<robot name="t">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint></robot>)");
+  EXPECT_EQ(twoRoots.status.code(), ErrorCode::NotATree) << twoRoots.status.message();
 }
 
 TEST(Urdf, NonexistentFileIsFileNotFound) {
