@@ -54,6 +54,7 @@ void Skeleton::rebuildShapes() {
 double Skeleton::restPosition(int joint) const { return clampToLimits(joint, 0.0); }
 
 double Skeleton::clampToLimits(int joint, double q) const {
+  assert(joint >= 0 && joint < jointCount() && "joint index out of range");
   const JointDesc& j = model_->joints()[static_cast<std::size_t>(joint)];
   return j.hasLimits ? std::clamp(q, j.lower, j.upper) : q;
 }
@@ -141,6 +142,7 @@ void Skeleton::updatePoses() const {
 }
 
 const Eigen::Isometry3d& Skeleton::linkPose(int link) const {
+  assert(link >= 0 && link < linkCount() && "link index out of range");
   updatePoses();
   return poses_[static_cast<std::size_t>(link)];
 }

@@ -206,6 +206,10 @@ struct UrdfModelBuilder {
       joint.name = src->name;
       Status s = readJoint(*src, joint);
       if (!s.ok()) return s;
+      if (src->mimic) {
+        model->warnings_.push_back("joint '" + src->name + "' mimics '" + src->mimic->joint_name +
+                                   "': mimic is not followed, the joint moves only when set");
+      }
       joint.parentLink = model->linkIndex_.at(src->parent_link_name);
       joint.childLink = static_cast<int>(k);
       const int index = static_cast<int>(model->joints_.size());

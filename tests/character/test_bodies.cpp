@@ -190,3 +190,41 @@ TEST(CharacterBodies, DynamicBodiesAreShovedByTheWalk) {
   }
   w.world.removeRigidBody(&ball);
 }
+
+TEST(CharacterBodies, ScaledCharacterHasScaledShapes) {
+  World w;
+  CharacterSettings settings;
+  settings.scale = 2.0;
+  settings.offset = Eigen::Vector3d(2.0, 0.0, 0.0);  // a crowd member 2 m to the right
+  CharacterResult made = Character::create(humanoid(), w.world, Gait::forScene(cape::SceneKind::Hang), settings);
+  ASSERT_TRUE(made.ok()) << made.status.message();
+  const btRigidBody* shoulder = made.character->bodies().bodyForLink("right_shoulder");
+  ASSERT_EQ(shoulder->getCollisionShape()->getShapeType(), SPHERE_SHAPE_PROXYTYPE);
+  EXPECT_NEAR(static_cast<const btSphereShape*>(shoulder->getCollisionShape())->getRadius(), 0.16, 1e-6);
+  const btVector3& p = shoulder->getWorldTransform().getOrigin();
+  EXPECT_NEAR(p.x(), 2.0 + 0.44, 1e-6);
+  EXPECT_NEAR(p.y(), 3.04, 1e-6);
+
+  CharacterSettings bad;
+  bad.scale = -1.0;
+  EXPECT_EQ(Character::create(humanoid(), w.world, Gait::forScene(cape::SceneKind::Hang), bad).status.code(),
+            ErrorCode::InvalidArgument);
+  EXPECT_EQ(Character::create(nullptr, w.world, Gait::forScene(cape::SceneKind::Hang)).status.code(),
+            ErrorCode::InvalidArgument);
+  EXPECT_EQ(w.world.getNumCollisionObjects(), 15);  // failed creations added nothing
+}
+
+TEST(CharacterBodies, GoingBackInTimeIsAJumpWithoutVelocity) {
+  World w;
+  CharacterResult made = Character::create(humanoid(), w.world, Gait::forScene(cape::SceneKind::Walk));
+  ASSERT_TRUE(made.ok());
+  Character& c = *made.character;
+  c.advanceTo(0.5);
+  EXPECT_GT(c.bodies().bodyForLink("torso")->getLinearVelocity().length(), 1.0f);  // 0.5 s in one update
+  c.advanceTo(0.1);
+  w.world.stepSimulation(btScalar(1.0 / 60.0), 8, btScalar(1.0 / 240.0));
+  EXPECT_EQ(c.bodies().bodyForLink("torso")->getLinearVelocity().length(), 0.0f);
+  const int torso = c.skeleton().model().findLink("torso");
+  EXPECT_EQ(c.bodies().previousTransform(torso).getOrigin(), c.bodies().currentTransform(torso).getOrigin());
+  EXPECT_NEAR(c.bodies().currentTransform(torso).getOrigin().z(), -0.14, 1e-6);
+}

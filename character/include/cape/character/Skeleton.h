@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 
+#include <cassert>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,7 @@ namespace cape::character {
 struct WorldShape {
   int link = -1;
   const std::string* linkName = nullptr;  ///< points into the model; valid while the Skeleton lives
-  const ShapeDesc* shape = nullptr;       ///< sizes in world metres (scale applied); valid while the Skeleton lives
+  const ShapeDesc* shape = nullptr;       ///< sizes in world metres (scale applied); valid until setScale
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< the shape's frame in the world
 };
 
@@ -55,7 +56,10 @@ class Skeleton {
   Status setJointPosition(int joint, double q);
   /// UnknownJoint if there is no such joint.
   Status jointPosition(const std::string& name, double& q) const;
-  double jointPosition(int joint) const { return q_[static_cast<std::size_t>(joint)]; }
+  double jointPosition(int joint) const {
+    assert(joint >= 0 && joint < jointCount() && "joint index out of range");
+    return q_[static_cast<std::size_t>(joint)];
+  }
   /// One value per joint, in model().joints() order (0 for joints that are not movable).
   const std::vector<double>& jointPositions() const { return q_; }
   /// Rest position of a joint: 0, or the nearest limit when 0 lies outside the limits.
@@ -80,7 +84,10 @@ class Skeleton {
   /// UnknownLink if there is no such link.
   Status linkPose(const std::string& name, Eigen::Isometry3d& pose) const;
   /// A link's collision shapes with the scale applied (origins in the link frame).
-  const std::vector<ShapeDesc>& shapes(int link) const { return shapes_[static_cast<std::size_t>(link)]; }
+  const std::vector<ShapeDesc>& shapes(int link) const {
+    assert(link >= 0 && link < linkCount() && "link index out of range");
+    return shapes_[static_cast<std::size_t>(link)];
+  }
   /// Every collision shape of every link placed in the world, in link order; `out` is reused (no allocation
   /// once it has grown).
   void worldShapes(std::vector<WorldShape>& out) const;
