@@ -26,14 +26,16 @@ std::unique_ptr<btCollisionShape> makeShape(const ShapeDesc& s) {
           btVector3(btScalar(s.halfExtents.x()), btScalar(s.halfExtents.y()), btScalar(s.halfExtents.z())));
     case ShapeType::Cylinder:
       // btCylinderShapeZ takes half extents (radius, radius, half length) with its axis along local z.
-      return std::make_unique<btCylinderShapeZ>(btVector3(btScalar(s.radius), btScalar(s.radius), btScalar(s.halfLength)));
+      return std::make_unique<btCylinderShapeZ>(
+          btVector3(btScalar(s.radius), btScalar(s.radius), btScalar(s.halfLength)));
   }
   return nullptr;
 }
 
 }  // namespace
 
-CharacterBodies::CharacterBodies(btDynamicsWorld& world, const Skeleton& skeleton, const BodySettings& settings)
+CharacterBodies::CharacterBodies(btDynamicsWorld& world, const Skeleton& skeleton,
+                                 const BodySettings& settings)
     : world_(&world), skeleton_(&skeleton), settings_(settings) {
   const int n = skeleton.linkCount();
   links_.resize(static_cast<std::size_t>(n));
@@ -51,8 +53,8 @@ CharacterBodies::CharacterBodies(btDynamicsWorld& world, const Skeleton& skeleto
       shape = lb.childShapes.back().get();
     } else {
       // Several elements, or one off the link origin: a compound whose children sit at the collision origins.
-      auto compound = std::make_unique<btCompoundShape>(/*enableDynamicAabbTree=*/false,
-                                                        static_cast<int>(shapes.size()));
+      auto compound =
+          std::make_unique<btCompoundShape>(/*enableDynamicAabbTree=*/false, static_cast<int>(shapes.size()));
       for (const ShapeDesc& s : shapes) {
         lb.childShapes.push_back(makeShape(s));
         compound->addChildShape(toBullet(s.origin), lb.childShapes.back().get());
@@ -109,8 +111,9 @@ void CharacterBodies::place(LinkBody& lb, const btTransform& t, double dt) {
   btRigidBody* body = lb.body.get();
   body->setWorldTransform(t);
   // Bullet derives a kinematic body's velocity from its interpolation transform to the motion state's pose at
-  // the next stepSimulation. Setting the former to our previous pose keeps that velocity equal to ours even when
-  // the world was not stepped after every update; for a jump both are the new pose, so nothing seems to move.
+  // the next stepSimulation. Setting the former to our previous pose keeps that velocity equal to ours even
+  // when the world was not stepped after every update; for a jump both are the new pose, so nothing seems to
+  // move.
   body->setInterpolationWorldTransform(dt > 0.0 ? lb.previous : t);
   body->setLinearVelocity(linear);
   body->setAngularVelocity(angular);

@@ -51,7 +51,9 @@ Gait Gait::fromMotion(const cape::MotionDesc& motion) {
   return g;
 }
 
-Gait Gait::forScene(cape::SceneKind kind) { return fromMotion(cape::MotionDesc::forScene(kind)); }
+Gait Gait::forScene(cape::SceneKind kind) {
+  return fromMotion(cape::MotionDesc::forScene(kind));
+}
 
 RootPose Gait::rootAt(double t) const {
   RootPose r;
@@ -79,7 +81,8 @@ std::array<double, kGaitRoleCount> Gait::anglesAt(double t) const {
   const double p = 2.0 * kPi * g.stepFrequency * t;
   const double s = std::sin(p), c = std::cos(p);
   auto at = [&](GaitRole role) -> double& { return a[static_cast<std::size_t>(role)]; };
-  // The hip angle uses the same float amplitude and formula as motionAt's legAngle when it comes from a scene.
+  // The hip angle uses the same float amplitude and formula as motionAt's legAngle when it comes from a
+  // scene.
   const double hip = g.hipAmplitude * s;
   at(GaitRole::LeftHip) = hip;
   at(GaitRole::RightHip) = -hip;
@@ -95,7 +98,8 @@ std::array<double, kGaitRoleCount> Gait::anglesAt(double t) const {
   return a;
 }
 
-void Gait::apply(double t, const JointMapping& mapping, Skeleton& skeleton, const Eigen::Vector3d& offset) const {
+void Gait::apply(double t, const JointMapping& mapping, Skeleton& skeleton,
+                 const Eigen::Vector3d& offset) const {
   const RootPose root = rootAt(t);
   skeleton.setRoot(root.origin + offset, root.yaw);
   const std::array<double, kGaitRoleCount> angles = anglesAt(t);
@@ -103,7 +107,8 @@ void Gait::apply(double t, const JointMapping& mapping, Skeleton& skeleton, cons
     const JointMapping::Entry& e = mapping.entries()[static_cast<std::size_t>(r)];
     if (e.joint < 0) continue;
     // Clamped here, so setJointPosition never reports OutsideLimits for the gait.
-    (void)skeleton.setJointPosition(e.joint, skeleton.clampToLimits(e.joint, e.sign * angles[static_cast<std::size_t>(r)]));
+    (void)skeleton.setJointPosition(
+        e.joint, skeleton.clampToLimits(e.joint, e.sign * angles[static_cast<std::size_t>(r)]));
   }
 }
 

@@ -11,16 +11,26 @@ namespace cape::character {
 
 const char* toString(GaitRole role) {
   switch (role) {
-    case GaitRole::LeftHip: return "left hip";
-    case GaitRole::RightHip: return "right hip";
-    case GaitRole::LeftKnee: return "left knee";
-    case GaitRole::RightKnee: return "right knee";
-    case GaitRole::LeftAnkle: return "left ankle";
-    case GaitRole::RightAnkle: return "right ankle";
-    case GaitRole::LeftShoulder: return "left shoulder";
-    case GaitRole::RightShoulder: return "right shoulder";
-    case GaitRole::LeftElbow: return "left elbow";
-    case GaitRole::RightElbow: return "right elbow";
+    case GaitRole::LeftHip:
+      return "left hip";
+    case GaitRole::RightHip:
+      return "right hip";
+    case GaitRole::LeftKnee:
+      return "left knee";
+    case GaitRole::RightKnee:
+      return "right knee";
+    case GaitRole::LeftAnkle:
+      return "left ankle";
+    case GaitRole::RightAnkle:
+      return "right ankle";
+    case GaitRole::LeftShoulder:
+      return "left shoulder";
+    case GaitRole::RightShoulder:
+      return "right shoulder";
+    case GaitRole::LeftElbow:
+      return "left elbow";
+    case GaitRole::RightElbow:
+      return "right elbow";
   }
   return "unknown role";
 }
@@ -37,11 +47,14 @@ double wantedForwardMotion(GaitRole role) {
 }
 
 std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
 }
 
-bool startsWith(const std::string& s, const std::string& p) { return s.compare(0, p.size(), p) == 0; }
+bool startsWith(const std::string& s, const std::string& p) {
+  return s.compare(0, p.size(), p) == 0;
+}
 bool endsWith(const std::string& s, const std::string& p) {
   return s.size() >= p.size() && s.compare(s.size() - p.size(), p.size(), p) == 0;
 }
@@ -54,8 +67,10 @@ int sideOf(const std::string& n, std::size_t at) {
   if (left && right) return kNoSide;
   for (const char* sep : {"_", "-", "."}) {
     const std::string s(sep);
-    if (startsWith(n, "l" + s) || endsWith(n, s + "l") || n.find(s + "l" + s) != std::string::npos) return kLeft;
-    if (startsWith(n, "r" + s) || endsWith(n, s + "r") || n.find(s + "r" + s) != std::string::npos) return kRight;
+    if (startsWith(n, "l" + s) || endsWith(n, s + "l") || n.find(s + "l" + s) != std::string::npos)
+      return kLeft;
+    if (startsWith(n, "r" + s) || endsWith(n, s + "r") || n.find(s + "r" + s) != std::string::npos)
+      return kRight;
   }
   // "lknee", "j_rhip": a lone l or r right before the part.
   if (at > 0 && (n[at - 1] == 'l' || n[at - 1] == 'r') &&
@@ -80,8 +95,8 @@ std::vector<int> subtree(const UrdfModel& m, int link) {
   return out;
 }
 
-// Centroid of the link origins and shape centres of `links`, in the URDF root frame (the skeleton's root is at
-// the world origin with yaw 0, so undoing urdfToWorld is enough).
+// Centroid of the link origins and shape centres of `links`, in the URDF root frame (the skeleton's root is
+// at the world origin with yaw 0, so undoing urdfToWorld is enough).
 Eigen::Vector3d centroid(const Skeleton& s, const std::vector<int>& links) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int count = 0;
@@ -103,13 +118,16 @@ Eigen::Vector3d axisInRoot(const Skeleton& s, int joint) {
   return Skeleton::urdfToWorld().transpose() * (s.linkPose(j.childLink).linear() * j.axis);
 }
 
-bool isRotary(const JointDesc& j) { return j.type == JointType::Revolute || j.type == JointType::Continuous; }
+bool isRotary(const JointDesc& j) {
+  return j.type == JointType::Revolute || j.type == JointType::Continuous;
+}
 
 }  // namespace
 
 std::array<std::string, kGaitRoleCount> JointMapping::shippedHumanoidNames() {
-  return {"left_hip_pitch", "right_hip_pitch", "left_knee",           "right_knee", "left_ankle",
-          "right_ankle",    "left_shoulder_pitch", "right_shoulder_pitch", "left_elbow", "right_elbow"};
+  return {"left_hip_pitch", "right_hip_pitch", "left_knee",           "right_knee",
+          "left_ankle",     "right_ankle",     "left_shoulder_pitch", "right_shoulder_pitch",
+          "left_elbow",     "right_elbow"};
 }
 
 JointMapping JointMapping::fromNames(const UrdfModelPtr& model,
@@ -120,7 +138,8 @@ JointMapping JointMapping::fromNames(const UrdfModelPtr& model,
     if (name.empty()) continue;
     const int j = model->findJoint(name);
     if (j < 0) {
-      m.warnings_.push_back(std::string(toString(static_cast<GaitRole>(r))) + ": no joint named '" + name + "'");
+      m.warnings_.push_back(std::string(toString(static_cast<GaitRole>(r))) + ": no joint named '" + name +
+                            "'");
       continue;
     }
     if (!isRotary(model->joints()[static_cast<std::size_t>(j)])) {
@@ -158,8 +177,8 @@ JointMapping JointMapping::byCommonNames(const UrdfModelPtr& model) {
         }
       }
       if (best >= 0 && bestLateral < 0.5) {
-        m.warnings_.push_back(std::string(toString(role)) + ": no candidate turns about the side-to-side axis (" +
-                              candidates + ")");
+        m.warnings_.push_back(std::string(toString(role)) +
+                              ": no candidate turns about the side-to-side axis (" + candidates + ")");
         best = -1;
       }
       m.entries_[static_cast<std::size_t>(role)].joint = best;
@@ -171,8 +190,8 @@ JointMapping JointMapping::byCommonNames(const UrdfModelPtr& model) {
 
 JointMapping JointMapping::automatic(const UrdfModelPtr& model) {
   const auto names = shippedHumanoidNames();
-  const bool all = std::all_of(names.begin(), names.end(),
-                               [&](const std::string& n) { return model->findJoint(n) >= 0; });
+  const bool all =
+      std::all_of(names.begin(), names.end(), [&](const std::string& n) { return model->findJoint(n) >= 0; });
   return all ? fromNames(model, names) : byCommonNames(model);
 }
 

@@ -51,7 +51,9 @@ void Skeleton::rebuildShapes() {
   }
 }
 
-double Skeleton::restPosition(int joint) const { return clampToLimits(joint, 0.0); }
+double Skeleton::restPosition(int joint) const {
+  return clampToLimits(joint, 0.0);
+}
 
 double Skeleton::clampToLimits(int joint, double q) const {
   assert(joint >= 0 && joint < jointCount() && "joint index out of range");
@@ -66,7 +68,9 @@ void Skeleton::resetJointPositions() {
 
 Status Skeleton::setJointPosition(const std::string& name, double q) {
   const int j = jointIndex(name);
-  if (j < 0) return Status::error(ErrorCode::UnknownJoint, "no joint named '" + name + "' in '" + model_->name() + "'");
+  if (j < 0)
+    return Status::error(ErrorCode::UnknownJoint,
+                         "no joint named '" + name + "' in '" + model_->name() + "'");
   return setJointPosition(j, q);
 }
 
@@ -87,8 +91,8 @@ Status Skeleton::setJointPosition(int joint, double q) {
   dirty_ = true;
   if (clamped != q) {
     std::ostringstream msg;
-    msg << "joint '" << j.name << "': " << q << " is outside [" << j.lower << ", " << j.upper << "], clamped to "
-        << clamped;
+    msg << "joint '" << j.name << "': " << q << " is outside [" << j.lower << ", " << j.upper
+        << "], clamped to " << clamped;
     return Status::error(ErrorCode::OutsideLimits, msg.str());
   }
   return Status::success();
@@ -96,7 +100,9 @@ Status Skeleton::setJointPosition(int joint, double q) {
 
 Status Skeleton::jointPosition(const std::string& name, double& q) const {
   const int j = jointIndex(name);
-  if (j < 0) return Status::error(ErrorCode::UnknownJoint, "no joint named '" + name + "' in '" + model_->name() + "'");
+  if (j < 0)
+    return Status::error(ErrorCode::UnknownJoint,
+                         "no joint named '" + name + "' in '" + model_->name() + "'");
   q = q_[static_cast<std::size_t>(j)];
   return Status::success();
 }
@@ -149,7 +155,8 @@ const Eigen::Isometry3d& Skeleton::linkPose(int link) const {
 
 Status Skeleton::linkPose(const std::string& name, Eigen::Isometry3d& pose) const {
   const int l = model_->findLink(name);
-  if (l < 0) return Status::error(ErrorCode::UnknownLink, "no link named '" + name + "' in '" + model_->name() + "'");
+  if (l < 0)
+    return Status::error(ErrorCode::UnknownLink, "no link named '" + name + "' in '" + model_->name() + "'");
   pose = linkPose(l);
   return Status::success();
 }

@@ -18,38 +18,58 @@ namespace cape::character {
 
 const char* toString(ErrorCode code) {
   switch (code) {
-    case ErrorCode::Ok: return "ok";
-    case ErrorCode::FileNotFound: return "file not found";
-    case ErrorCode::MalformedXml: return "malformed XML";
-    case ErrorCode::InvalidModel: return "invalid URDF model";
-    case ErrorCode::MissingLink: return "missing link";
-    case ErrorCode::NotATree: return "links do not form a tree";
-    case ErrorCode::UnknownJoint: return "unknown joint";
-    case ErrorCode::UnknownLink: return "unknown link";
-    case ErrorCode::OutsideLimits: return "outside joint limits";
-    case ErrorCode::NotMovable: return "joint not movable";
-    case ErrorCode::InvalidArgument: return "invalid argument";
+    case ErrorCode::Ok:
+      return "ok";
+    case ErrorCode::FileNotFound:
+      return "file not found";
+    case ErrorCode::MalformedXml:
+      return "malformed XML";
+    case ErrorCode::InvalidModel:
+      return "invalid URDF model";
+    case ErrorCode::MissingLink:
+      return "missing link";
+    case ErrorCode::NotATree:
+      return "links do not form a tree";
+    case ErrorCode::UnknownJoint:
+      return "unknown joint";
+    case ErrorCode::UnknownLink:
+      return "unknown link";
+    case ErrorCode::OutsideLimits:
+      return "outside joint limits";
+    case ErrorCode::NotMovable:
+      return "joint not movable";
+    case ErrorCode::InvalidArgument:
+      return "invalid argument";
   }
   return "unknown error";
 }
 
 const char* toString(ShapeType type) {
   switch (type) {
-    case ShapeType::Sphere: return "sphere";
-    case ShapeType::Box: return "box";
-    case ShapeType::Cylinder: return "cylinder";
+    case ShapeType::Sphere:
+      return "sphere";
+    case ShapeType::Box:
+      return "box";
+    case ShapeType::Cylinder:
+      return "cylinder";
   }
   return "unknown";
 }
 
 const char* toString(JointType type) {
   switch (type) {
-    case JointType::Fixed: return "fixed";
-    case JointType::Revolute: return "revolute";
-    case JointType::Continuous: return "continuous";
-    case JointType::Prismatic: return "prismatic";
-    case JointType::Floating: return "floating";
-    case JointType::Planar: return "planar";
+    case JointType::Fixed:
+      return "fixed";
+    case JointType::Revolute:
+      return "revolute";
+    case JointType::Continuous:
+      return "continuous";
+    case JointType::Prismatic:
+      return "prismatic";
+    case JointType::Floating:
+      return "floating";
+    case JointType::Planar:
+      return "planar";
   }
   return "unknown";
 }
@@ -95,18 +115,22 @@ std::string joinLines(const std::vector<std::string>& lines) {
   return out;
 }
 
-bool contains(const std::string& text, const char* part) { return text.find(part) != std::string::npos; }
+bool contains(const std::string& text, const char* part) {
+  return text.find(part) != std::string::npos;
+}
 
 std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
 }
 
-// urdfdom links own their children through shared pointers: fed a cycle, the links own each other and are never
-// freed (LeakSanitizer says so), whether urdfdom then rejects the model or not. So the joint graph is checked here
-// first, on the XML outline: each link the child of at most one joint, and no loop of parents.
+// urdfdom links own their children through shared pointers: fed a cycle, the links own each other and are
+// never freed (LeakSanitizer says so), whether urdfdom then rejects the model or not. So the joint graph is
+// checked here first, on the XML outline: each link the child of at most one joint, and no loop of parents.
 Status checkJointGraph(const std::vector<XmlElement>& outline) {
-  if (outline.empty() || outline[0].name != "robot") return Status::success();  // urdfdom will say what is wrong
+  if (outline.empty() || outline[0].name != "robot")
+    return Status::success();                             // urdfdom will say what is wrong
   std::unordered_map<std::string, std::string> parentOf;  // child link -> parent link
   std::unordered_map<std::string, std::string> jointOf;   // child link -> joint
   for (std::size_t i = 1; i < outline.size(); ++i) {
@@ -201,7 +225,8 @@ struct UrdfModelBuilder {
 
     for (std::size_t k = 1; k < order.size(); ++k) {
       const urdf::JointSharedPtr& src = order[k]->parent_joint;
-      if (!src) return Status::error(ErrorCode::NotATree, "link '" + order[k]->name + "' has no parent joint");
+      if (!src)
+        return Status::error(ErrorCode::NotATree, "link '" + order[k]->name + "' has no parent joint");
       JointDesc joint;
       joint.name = src->name;
       Status s = readJoint(*src, joint);
@@ -225,13 +250,26 @@ struct UrdfModelBuilder {
 
   static Status readJoint(const urdf::Joint& src, JointDesc& joint) {
     switch (src.type) {
-      case urdf::Joint::REVOLUTE: joint.type = JointType::Revolute; break;
-      case urdf::Joint::CONTINUOUS: joint.type = JointType::Continuous; break;
-      case urdf::Joint::PRISMATIC: joint.type = JointType::Prismatic; break;
-      case urdf::Joint::FLOATING: joint.type = JointType::Floating; break;
-      case urdf::Joint::PLANAR: joint.type = JointType::Planar; break;
-      case urdf::Joint::FIXED: joint.type = JointType::Fixed; break;
-      default: return Status::error(ErrorCode::InvalidModel, "joint '" + src.name + "' has an unknown type");
+      case urdf::Joint::REVOLUTE:
+        joint.type = JointType::Revolute;
+        break;
+      case urdf::Joint::CONTINUOUS:
+        joint.type = JointType::Continuous;
+        break;
+      case urdf::Joint::PRISMATIC:
+        joint.type = JointType::Prismatic;
+        break;
+      case urdf::Joint::FLOATING:
+        joint.type = JointType::Floating;
+        break;
+      case urdf::Joint::PLANAR:
+        joint.type = JointType::Planar;
+        break;
+      case urdf::Joint::FIXED:
+        joint.type = JointType::Fixed;
+        break;
+      default:
+        return Status::error(ErrorCode::InvalidModel, "joint '" + src.name + "' has an unknown type");
     }
     joint.origin = toIsometry(src.parent_to_joint_origin_transform);
     const Eigen::Vector3d axis(src.axis.x, src.axis.y, src.axis.z);
@@ -306,10 +344,10 @@ struct UrdfModelBuilder {
       }
       const bool finite = std::isfinite(shape.radius) && std::isfinite(shape.halfLength) &&
                           shape.halfExtents.allFinite() && shape.origin.matrix().allFinite();
-      const bool positive = (shape.type == ShapeType::Box) ? (shape.halfExtents.array() > 0.0).all()
-                                                            : shape.radius > 0.0 &&
-                                                                  (shape.type != ShapeType::Cylinder ||
-                                                                   shape.halfLength > 0.0);
+      const bool positive =
+          (shape.type == ShapeType::Box)
+              ? (shape.halfExtents.array() > 0.0).all()
+              : shape.radius > 0.0 && (shape.type != ShapeType::Cylinder || shape.halfLength > 0.0);
       if (!finite || !positive) {
         return Status::error(ErrorCode::InvalidModel, "link '" + src.name + "': collision element '" + label +
                                                           "' has a non-positive or non-finite size");
@@ -359,7 +397,8 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xml) {
     } else if (contains(what, "root link")) {
       code = ErrorCode::NotATree;  // "No root link found" (a cycle) or "Two root links found"
     }
-    result.status = Status::error(code, "URDF rejected by urdfdom: " + (what.empty() ? "no reason given" : what));
+    result.status =
+        Status::error(code, "URDF rejected by urdfdom: " + (what.empty() ? "no reason given" : what));
     return result;
   }
 
@@ -372,7 +411,8 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xml) {
   try {
     result.status = UrdfModelBuilder::build(*parsed, std::move(warnings), model);
   } catch (const std::exception& e) {
-    result.status = Status::error(ErrorCode::InvalidModel, std::string("URDF could not be read: ") + e.what());
+    result.status =
+        Status::error(ErrorCode::InvalidModel, std::string("URDF could not be read: ") + e.what());
   }
   release(parsed);
   if (result.status.ok()) result.model = std::move(model);
@@ -383,7 +423,8 @@ UrdfLoadResult UrdfModel::fromFile(const std::string& path) {
   UrdfLoadResult result;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
-    result.status = Status::error(ErrorCode::FileNotFound, "URDF file '" + path + "' does not exist or is not a file");
+    result.status =
+        Status::error(ErrorCode::FileNotFound, "URDF file '" + path + "' does not exist or is not a file");
     return result;
   }
   std::ifstream in(path, std::ios::binary);
@@ -399,7 +440,9 @@ UrdfLoadResult UrdfModel::fromFile(const std::string& path) {
   return result;
 }
 
-UrdfLoadResult UrdfModel::humanoid() { return fromString(humanoidUrdf()); }
+UrdfLoadResult UrdfModel::humanoid() {
+  return fromString(humanoidUrdf());
+}
 
 int UrdfModel::findLink(const std::string& name) const {
   const auto it = linkIndex_.find(name);

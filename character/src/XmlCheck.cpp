@@ -41,7 +41,8 @@ class XmlScanner {
         const std::string name = readName();
         if (name.empty()) return fail(message, "end tag without a name");
         skipSpace();
-        if (i_ >= s_.size() || s_[i_] != '>') return fail(message, "end tag </" + name + "> not closed by '>'");
+        if (i_ >= s_.size() || s_[i_] != '>')
+          return fail(message, "end tag </" + name + "> not closed by '>'");
         advance(1);
         if (stack_.empty()) return fail(message, "end tag </" + name + "> without a start tag");
         if (stack_.back() != name) {
@@ -74,7 +75,9 @@ class XmlScanner {
   }
 
  private:
-  bool startsWith(const char* prefix) const { return s_.compare(i_, std::char_traits<char>::length(prefix), prefix) == 0; }
+  bool startsWith(const char* prefix) const {
+    return s_.compare(i_, std::char_traits<char>::length(prefix), prefix) == 0;
+  }
 
   void advance(std::size_t n) {
     for (std::size_t k = 0; k < n && i_ < s_.size(); ++k, ++i_) {
@@ -109,7 +112,8 @@ class XmlScanner {
 
   std::string readName() {
     const std::size_t start = i_;
-    if (i_ < s_.size() && (std::isdigit(static_cast<unsigned char>(s_[i_])) || s_[i_] == '-' || s_[i_] == '.')) {
+    if (i_ < s_.size() &&
+        (std::isdigit(static_cast<unsigned char>(s_[i_])) || s_[i_] == '-' || s_[i_] == '.')) {
       return std::string();
     }
     while (i_ < s_.size() && isNameChar(s_[i_])) ++i_;
@@ -144,7 +148,8 @@ class XmlScanner {
         if (other.first == attr) return fail(message, "attribute '" + attr + "' given twice");
       }
       skipSpace();
-      if (i_ >= s_.size() || s_[i_] != '=') return fail(message, "attribute '" + attr + "' without '=' and a value");
+      if (i_ >= s_.size() || s_[i_] != '=')
+        return fail(message, "attribute '" + attr + "' without '=' and a value");
       advance(1);
       skipSpace();
       if (i_ >= s_.size() || (s_[i_] != '"' && s_[i_] != '\'')) {
@@ -172,7 +177,7 @@ class XmlScanner {
   std::size_t i_ = 0;
   int line_ = 1;
   std::vector<std::string> stack_;  ///< names of the open elements
-  std::vector<int> open_;            ///< their indices in *outline_ (-1 without an outline)
+  std::vector<int> open_;           ///< their indices in *outline_ (-1 without an outline)
   std::vector<XmlElement>* outline_;
 };
 
@@ -184,7 +189,9 @@ bool scanXml(const std::string& text, std::string& message, std::vector<XmlEleme
   return scanner.run(message);
 }
 
-bool checkXmlWellFormed(const std::string& text, std::string& message) { return scanXml(text, message, nullptr); }
+bool checkXmlWellFormed(const std::string& text, std::string& message) {
+  return scanXml(text, message, nullptr);
+}
 
 const std::string* XmlElement::attribute(const std::string& key) const {
   for (const auto& [k, v] : attributes) {

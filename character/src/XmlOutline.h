@@ -1,5 +1,5 @@
-// Internal: the element outline the XML check can record on the way (names, nesting, raw attribute values), so
-// that the loader can look at the joint graph before handing the text to urdfdom.
+// Internal: the element outline the XML check can record on the way (names, nesting, raw attribute values),
+// so that the loader can look at the joint graph before handing the text to urdfdom.
 #pragma once
 
 #include <string>

@@ -132,7 +132,8 @@ TEST(CharacterBodies, FollowTheSkeletonThroughBulletSteps) {
     std::vector<Eigen::Isometry3d> before(static_cast<std::size_t>(c.skeleton().linkCount()));
     double worst = 0.0, worstVelocity = 0.0;
     for (int frame = 1; frame <= 240; ++frame) {  // 4 s: the sprint-turn's first two turns
-      for (int l = 0; l < c.skeleton().linkCount(); ++l) before[static_cast<std::size_t>(l)] = c.skeleton().linkPose(l);
+      for (int l = 0; l < c.skeleton().linkCount(); ++l)
+        before[static_cast<std::size_t>(l)] = c.skeleton().linkPose(l);
       c.advanceTo(frame * dt);
       w.world.stepSimulation(btScalar(1.0 / 60.0), 8, btScalar(1.0 / 240.0));
       for (btRigidBody* body : c.bodies().bodies()) {
@@ -143,7 +144,8 @@ TEST(CharacterBodies, FollowTheSkeletonThroughBulletSteps) {
         body->getMotionState()->getWorldTransform(fromMotionState);
         worst = std::max(worst, maxDifference(fromMotionState, pose));
         // Velocities: the pose change over the frame, as Bullet computes it for kinematic bodies.
-        const Eigen::Vector3d v = (pose.translation() - before[static_cast<std::size_t>(l)].translation()) / dt;
+        const Eigen::Vector3d v =
+            (pose.translation() - before[static_cast<std::size_t>(l)].translation()) / dt;
         const btVector3& bv = body->getLinearVelocity();
         worstVelocity = std::max(worstVelocity, (Eigen::Vector3d(bv.x(), bv.y(), bv.z()) - v).norm());
       }
@@ -196,7 +198,8 @@ TEST(CharacterBodies, ScaledCharacterHasScaledShapes) {
   CharacterSettings settings;
   settings.scale = 2.0;
   settings.offset = Eigen::Vector3d(2.0, 0.0, 0.0);  // a crowd member 2 m to the right
-  CharacterResult made = Character::create(humanoid(), w.world, Gait::forScene(cape::SceneKind::Hang), settings);
+  CharacterResult made =
+      Character::create(humanoid(), w.world, Gait::forScene(cape::SceneKind::Hang), settings);
   ASSERT_TRUE(made.ok()) << made.status.message();
   const btRigidBody* shoulder = made.character->bodies().bodyForLink("right_shoulder");
   ASSERT_EQ(shoulder->getCollisionShape()->getShapeType(), SPHERE_SHAPE_PROXYTYPE);

@@ -12,10 +12,14 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-UrdfModelPtr humanoid() { return UrdfModel::humanoid().model; }
+UrdfModelPtr humanoid() {
+  return UrdfModel::humanoid().model;
+}
 
 // A link pose in the character frame (root and bob removed).
-Eigen::Isometry3d inCharacterFrame(const Skeleton& s, int link) { return s.rootTransform().inverse() * s.linkPose(link); }
+Eigen::Isometry3d inCharacterFrame(const Skeleton& s, int link) {
+  return s.rootTransform().inverse() * s.linkPose(link);
+}
 
 }  // namespace
 
@@ -31,10 +35,12 @@ TEST(Gait, JointTrajectoriesArePeriodic) {
     for (double t = 0.0; t < 10.0; t += 0.0137) {
       gait.apply(t, mapping, a);
       gait.apply(t + period, mapping, b);
-      for (int j = 0; j < a.jointCount(); ++j) worst = std::max(worst, std::abs(a.jointPosition(j) - b.jointPosition(j)));
+      for (int j = 0; j < a.jointCount(); ++j)
+        worst = std::max(worst, std::abs(a.jointPosition(j) - b.jointPosition(j)));
       worst = std::max(worst, std::abs(gait.rootAt(t).bob - gait.rootAt(t + period).bob));
       for (int l = 0; l < a.linkCount(); ++l) {
-        worst = std::max(worst, (inCharacterFrame(a, l).matrix() - inCharacterFrame(b, l).matrix()).cwiseAbs().maxCoeff());
+        worst = std::max(
+            worst, (inCharacterFrame(a, l).matrix() - inCharacterFrame(b, l).matrix()).cwiseAbs().maxCoeff());
       }
     }
     EXPECT_LT(worst, 1e-6) << cape::toString(scene);
@@ -118,11 +124,14 @@ TEST(Gait, ArmsSwingAgainstTheLegsAndKneesBendInSwing) {
   EXPECT_GT(at(GaitRole::RightShoulder), 0.0);  // right arm forward
   EXPECT_GT(at(GaitRole::RightElbow), at(GaitRole::LeftElbow));
   const auto mid = gait.anglesAt(0.0);  // left leg passing under the body, swinging forward
-  EXPECT_GT(mid[static_cast<std::size_t>(GaitRole::LeftKnee)], mid[static_cast<std::size_t>(GaitRole::RightKnee)] + 0.5);
+  EXPECT_GT(mid[static_cast<std::size_t>(GaitRole::LeftKnee)],
+            mid[static_cast<std::size_t>(GaitRole::RightKnee)] + 0.5);
   // Sprinting bends knees and elbows more than walking.
   const auto sprint = Gait::forScene(cape::SceneKind::SprintTurn).anglesAt(0.0);
-  EXPECT_GT(sprint[static_cast<std::size_t>(GaitRole::LeftKnee)], mid[static_cast<std::size_t>(GaitRole::LeftKnee)]);
-  EXPECT_GT(sprint[static_cast<std::size_t>(GaitRole::LeftElbow)], mid[static_cast<std::size_t>(GaitRole::LeftElbow)]);
+  EXPECT_GT(sprint[static_cast<std::size_t>(GaitRole::LeftKnee)],
+            mid[static_cast<std::size_t>(GaitRole::LeftKnee)]);
+  EXPECT_GT(sprint[static_cast<std::size_t>(GaitRole::LeftElbow)],
+            mid[static_cast<std::size_t>(GaitRole::LeftElbow)]);
 }
 
 TEST(Gait, ConstantTurnRateFollowsTheArc) {

@@ -59,8 +59,10 @@ TEST(JointMapping, ShippedHumanoidIsFullyMappedWithPositiveSigns) {
   // The common-name fallback finds the same joints and signs on the shipped model.
   const JointMapping fallback = JointMapping::byCommonNames(model);
   for (int r = 0; r < kGaitRoleCount; ++r) {
-    EXPECT_EQ(fallback.entries()[static_cast<std::size_t>(r)].joint, m.entries()[static_cast<std::size_t>(r)].joint);
-    EXPECT_EQ(fallback.entries()[static_cast<std::size_t>(r)].sign, m.entries()[static_cast<std::size_t>(r)].sign);
+    EXPECT_EQ(fallback.entries()[static_cast<std::size_t>(r)].joint,
+              m.entries()[static_cast<std::size_t>(r)].joint);
+    EXPECT_EQ(fallback.entries()[static_cast<std::size_t>(r)].sign,
+              m.entries()[static_cast<std::size_t>(r)].sign);
   }
 }
 
@@ -86,13 +88,14 @@ TEST(JointMapping, CommonNamesOnAnotherHumanoid) {
 
   // Unmapped: no ankles, no elbows, and a right shoulder that only twists.
   std::vector<GaitRole> unmapped = m.unmappedRoles();
-  EXPECT_EQ(unmapped, (std::vector<GaitRole>{GaitRole::LeftAnkle, GaitRole::RightAnkle, GaitRole::RightShoulder,
-                                             GaitRole::LeftElbow, GaitRole::RightElbow}));
+  EXPECT_EQ(unmapped,
+            (std::vector<GaitRole>{GaitRole::LeftAnkle, GaitRole::RightAnkle, GaitRole::RightShoulder,
+                                   GaitRole::LeftElbow, GaitRole::RightElbow}));
   EXPECT_TRUE(hasWarningWith(m, "left ankle"));
   EXPECT_TRUE(hasWarningWith(m, "right_shoulder_twist"));
 
-  // Walking it: legs swing the right way (the left thigh forward, towards -Z in the world, at t = 1/4 period),
-  // and the knees bend the right way inside their limits.
+  // Walking it: legs swing the right way (the left thigh forward, towards -Z in the world, at t = 1/4
+  // period), and the knees bend the right way inside their limits.
   const Gait gait = Gait::forScene(cape::SceneKind::Walk);
   Skeleton s(r.model);
   gait.apply(0.25, m, s);

@@ -48,8 +48,8 @@ TEST(Skeleton, ForwardKinematicsMatchesHandComputedPoses) {
   Skeleton s = load(kTwoLink);
   ASSERT_TRUE(s.setJointPosition("j1", kPi / 2).ok());
   ASSERT_TRUE(s.setJointPosition("j2", 0.3).ok());
-  // URDF frame: arm at (1, 0, 0) turned 90 degrees about z; tip = (1,0,0) + Rz(90) (0.3, 0, 0.5) = (1, 0.3, 0.5).
-  // World: x -> -Z, y -> -X, z -> +Y gives (-0.3, 0.5, -1).
+  // URDF frame: arm at (1, 0, 0) turned 90 degrees about z; tip = (1,0,0) + Rz(90) (0.3, 0, 0.5) = (1, 0.3,
+  // 0.5). World: x -> -Z, y -> -X, z -> +Y gives (-0.3, 0.5, -1).
   EXPECT_TRUE(position(s, "base").isZero(1e-15));
   EXPECT_TRUE(position(s, "arm").isApprox(Eigen::Vector3d(0, 0, -1), 1e-12));
   EXPECT_TRUE(position(s, "tip").isApprox(Eigen::Vector3d(-0.3, 0.5, -1), 1e-12));

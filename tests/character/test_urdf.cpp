@@ -28,7 +28,8 @@ std::string twoJointUrdf(const std::string& parentOfA = "root") {
   <link name="root"/>
   <link name="a"><collision><geometry><sphere radius="0.1"/></geometry></collision></link>
   <link name="b"/>
-  <joint name="ja" type="revolute"><parent link=")" + parentOfA + R"("/><child link="a"/>
+  <joint name="ja" type="revolute"><parent link=")" +
+         parentOfA + R"("/><child link="a"/>
     <axis xyz="0 0 2"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
   <joint name="jb" type="fixed"><parent link="a"/><child link="b"/><origin xyz="0 0 1"/></joint>
 </robot>)";
@@ -163,10 +164,12 @@ TEST(Urdf, CyclesAreRejected) {
     <joint name="ba" type="fixed"><parent link="b"/><child link="a"/></joint>)";
   const UrdfLoadResult pure = UrdfModel::fromString("<robot name='c'>" + cycle + "</robot>");
   EXPECT_EQ(pure.status.code(), ErrorCode::NotATree) << pure.status.message();
-  const UrdfLoadResult beside = UrdfModel::fromString("<robot name='c'><link name='root'/>" + cycle + "</robot>");
+  const UrdfLoadResult beside =
+      UrdfModel::fromString("<robot name='c'><link name='root'/>" + cycle + "</robot>");
   EXPECT_EQ(beside.status.code(), ErrorCode::NotATree) << beside.status.message();
   const std::string& msg = beside.status.message();
-  EXPECT_TRUE(msg.find("a -> b -> a") != std::string::npos || msg.find("b -> a -> b") != std::string::npos) << msg;
+  EXPECT_TRUE(msg.find("a -> b -> a") != std::string::npos || msg.find("b -> a -> b") != std::string::npos)
+      << msg;
 }
 
 TEST(Urdf, TwoParentsOrTwoRootsAreNotATree) {
@@ -186,7 +189,8 @@ TEST(Urdf, NonexistentFileIsFileNotFound) {
   const UrdfLoadResult r = UrdfModel::fromFile("/nonexistent/dir/robot.urdf");
   EXPECT_EQ(r.status.code(), ErrorCode::FileNotFound);
   EXPECT_NE(r.status.message().find("/nonexistent/dir/robot.urdf"), std::string::npos);
-  EXPECT_EQ(UrdfModel::fromFile(CAPE_CHARACTER_MODELS_DIR).status.code(), ErrorCode::FileNotFound);  // a directory
+  EXPECT_EQ(UrdfModel::fromFile(CAPE_CHARACTER_MODELS_DIR).status.code(),
+            ErrorCode::FileNotFound);  // a directory
 }
 
 TEST(Urdf, MeshCollisionIsSkippedWithAWarningNamingTheLink) {
@@ -217,9 +221,10 @@ TEST(Urdf, UnreadableGeometryBecomesAWarning) {
 
 TEST(Urdf, XmlCheckAcceptsOrdinaryDocuments) {
   std::string msg;
-  EXPECT_TRUE(checkXmlWellFormed(
-      "\xEF\xBB\xBF<?xml version=\"1.0\"?>\n<!DOCTYPE r [<!ENTITY e \"x\">]>\n<r a='1' b = \"2\"><![CDATA[<x>]]>"
-      "<!-- <c> --><s/>t &amp; u</r>\n",
-      msg))
+  EXPECT_TRUE(
+      checkXmlWellFormed("\xEF\xBB\xBF<?xml version=\"1.0\"?>\n<!DOCTYPE r [<!ENTITY e \"x\">]>\n<r a='1' b "
+                         "= \"2\"><![CDATA[<x>]]>"
+                         "<!-- <c> --><s/>t &amp; u</r>\n",
+                         msg))
       << msg;
 }

@@ -8,9 +8,9 @@
 //   for (const std::string& w : made.character->warnings()) print(w);
 //   btRigidBody* leftShoulder = made.character->bodies().bodyForLink("left_shoulder");
 //   for (int frame = 1; frame <= 600; ++frame) {
-//     made.character->advanceTo(frame / 60.0);        // poses the skeleton, moves the bodies (velocities too)
-//     world.stepSimulation(1 / 60.f, 8, 1 / 240.f);
-//     made.character->skeleton().worldShapes(shapes);  // colliders to export: link, type, sizes, world pose
+//     made.character->advanceTo(frame / 60.0);        // poses the skeleton, moves the bodies (velocities
+//     too) world.stepSimulation(1 / 60.f, 8, 1 / 240.f); made.character->skeleton().worldShapes(shapes);  //
+//     colliders to export: link, type, sizes, world pose
 //   }
 #pragma once
 
@@ -26,9 +26,9 @@
 namespace cape::character {
 
 struct CharacterSettings {
-  double scale = 1.0;                                  ///< uniform scale of the URDF, > 0
-  Eigen::Vector3d offset = Eigen::Vector3d::Zero();    ///< m, world, added to the gait's root path (a crowd)
-  BodySettings bodies;                                 ///< collision group, mask, ...
+  double scale = 1.0;                                ///< uniform scale of the URDF, > 0
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();  ///< m, world, added to the gait's root path (a crowd)
+  BodySettings bodies;                               ///< collision group, mask, ...
 };
 
 class Character;
@@ -43,7 +43,8 @@ class Character {
   /// Builds the skeleton (joints mapped with JointMapping::automatic, unless `mapping` is given), poses it at
   /// t = 0 and adds its bodies to `world` at rest. Errors: InvalidArgument (null model, bad scale).
   static CharacterResult create(const UrdfModelPtr& model, btDynamicsWorld& world, const Gait& gait,
-                                const CharacterSettings& settings = {}, const JointMapping* mapping = nullptr);
+                                const CharacterSettings& settings = {},
+                                const JointMapping* mapping = nullptr);
 
   /// Poses the skeleton at time t (s) and moves the bodies there, with velocities over t - time(). A t not
   /// after time() is a jump (teleport, zero velocity). Call before stepping the world.
@@ -63,7 +64,8 @@ class Character {
   std::vector<std::string> warnings() const;
 
  private:
-  Character(const UrdfModelPtr& model, const Gait& gait, const CharacterSettings& settings, JointMapping mapping);
+  Character(const UrdfModelPtr& model, const Gait& gait, const CharacterSettings& settings,
+            JointMapping mapping);
   Skeleton skeleton_;
   Gait gait_;
   CharacterSettings settings_;

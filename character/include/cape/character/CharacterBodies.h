@@ -1,8 +1,9 @@
-// A skeleton's links as kinematic Bullet rigid bodies: what other rigid bodies (and the cape, through the Bullet
-// adapter) collide with.
+// A skeleton's links as kinematic Bullet rigid bodies: what other rigid bodies (and the cape, through the
+// Bullet adapter) collide with.
 //
-// One btRigidBody per link that has collision shapes (optionally also for links without: an empty shape), whose
-// frame is the link frame (so the compound child transforms are the URDF collision origins, scaled). Shapes:
+// One btRigidBody per link that has collision shapes (optionally also for links without: an empty shape),
+// whose frame is the link frame (so the compound child transforms are the URDF collision origins, scaled).
+// Shapes:
 //   URDF sphere   -> btSphereShape(radius)
 //   URDF box      -> btBoxShape(half extents)
 //   URDF cylinder -> btCylinderShapeZ(radius, radius, half length): URDF cylinders lie along their local z
@@ -11,12 +12,12 @@
 // Bullet's collision margins do not move these surfaces: a sphere's radius is its margin, and boxes and
 // cylinders keep their margin inside the given extents.
 //
-// The bodies are kinematic (mass 0, CF_KINEMATIC_OBJECT, DISABLE_DEACTIVATION): call update(dt) once per frame,
-// after posing the skeleton and before btDynamicsWorld::stepSimulation. It writes each link pose into the body's
-// motion state (what Bullet reads for kinematic bodies at the start of stepSimulation) and into the body itself
-// (so queries made before the step already see it), and sets linear and angular velocities from the pose change
-// over dt (btTransformUtil::calculateVelocity, the same rule Bullet applies) so contacts with dynamic bodies
-// push the right way.
+// The bodies are kinematic (mass 0, CF_KINEMATIC_OBJECT, DISABLE_DEACTIVATION): call update(dt) once per
+// frame, after posing the skeleton and before btDynamicsWorld::stepSimulation. It writes each link pose into
+// the body's motion state (what Bullet reads for kinematic bodies at the start of stepSimulation) and into
+// the body itself (so queries made before the step already see it), and sets linear and angular velocities
+// from the pose change over dt (btTransformUtil::calculateVelocity, the same rule Bullet applies) so contacts
+// with dynamic bodies push the right way.
 //
 // Ownership follows Bullet's rule: what we add we own and remove. The destructor removes the bodies from the
 // world and frees bodies, motion states and shapes; the world must outlive this object, and so must the
@@ -39,9 +40,11 @@ struct BodySettings {
   /// Collision filter group of every body of the character. Bullet's CharacterFilter by default.
   int group = btBroadphaseProxy::CharacterFilter;
   /// What they collide with: by default everything but other character bodies (the links of one skeleton
-  /// overlap at their joints) and static or kinematic objects (Bullet makes no contacts between those anyway).
-  int mask = btBroadphaseProxy::AllFilter & ~(btBroadphaseProxy::CharacterFilter | btBroadphaseProxy::StaticFilter |
-                                              btBroadphaseProxy::KinematicFilter);
+  /// overlap at their joints) and static or kinematic objects (Bullet makes no contacts between those
+  /// anyway).
+  int mask =
+      btBroadphaseProxy::AllFilter & ~(btBroadphaseProxy::CharacterFilter | btBroadphaseProxy::StaticFilter |
+                                       btBroadphaseProxy::KinematicFilter);
   /// Also make a body (with a btEmptyShape) for links without collision shapes, so that every link has one.
   bool bodiesForEmptyLinks = false;
   /// Friction and restitution given to every body (Bullet's defaults are 0.5 and 0).

@@ -5,8 +5,8 @@
 // canonical scenes exactly: for a scene, or for any gait that does not turn, it is the core's
 // cape::motionAt(MotionDesc, t) (shared/SCENARIOS.md: walk at 1.4 m/s, sprint-turn at 5 m/s with a 180 degree
 // turn in the last 0.5 s of every 2 s), with the torso bob added to the root height, as the simple body does.
-// A gait with a constant turn rate w follows the exact arc: yaw = w t, and with forward = (-sin yaw, 0, -cos yaw),
-// position = (v/w (cos w t - 1), 0, -v/w sin w t).
+// A gait with a constant turn rate w follows the exact arc: yaw = w t, and with forward = (-sin yaw, 0, -cos
+// yaw), position = (v/w (cos w t - 1), 0, -v/w sin w t).
 //
 // Joint angles, anatomical (see JointMapping.h), with phase p = 2 pi f t:
 //   hip       left  A sin p                        right  -A sin p   (SCENARIOS.md: A = 0.5236 rad)
@@ -30,11 +30,12 @@
 namespace cape::character {
 
 struct GaitParams {
-  double speed = 0.0;          ///< m/s along the heading
-  double turnRate = 0.0;       ///< rad/s about world +Y (positive turns to the character's left)
-  double stepFrequency = 0.0;  ///< Hz: full leg cycles per second (one left and one right step), SCENARIOS' "legs swing at"
-  double bobAmplitude = 0.0;   ///< m, half the peak-to-peak torso bob (the whole body rises and falls)
-  double bobFrequency = 0.0;   ///< Hz, usually 2 * stepFrequency (one bob per step)
+  double speed = 0.0;     ///< m/s along the heading
+  double turnRate = 0.0;  ///< rad/s about world +Y (positive turns to the character's left)
+  double stepFrequency =
+      0.0;  ///< Hz: full leg cycles per second (one left and one right step), SCENARIOS' "legs swing at"
+  double bobAmplitude = 0.0;     ///< m, half the peak-to-peak torso bob (the whole body rises and falls)
+  double bobFrequency = 0.0;     ///< Hz, usually 2 * stepFrequency (one bob per step)
   double hipAmplitude = 0.5236;  ///< rad, A above
   double kneeStance = 0.05;      ///< rad, k0: the knee's least bend
   double kneeSwing = 0.8;        ///< rad, K: extra bend at mid-swing
@@ -76,8 +77,9 @@ class Gait {
   RootPose rootAt(double t) const;
   /// Anatomical angles of every role at time t (rad), indexed by GaitRole.
   std::array<double, kGaitRoleCount> anglesAt(double t) const;
-  /// Poses `skeleton` at time t: the root (bob included, `offset` added: m, in the world, for characters side by
-  /// side) and every mapped joint; unmapped joints and joints of no role are left where they are. No allocation.
+  /// Poses `skeleton` at time t: the root (bob included, `offset` added: m, in the world, for characters side
+  /// by side) and every mapped joint; unmapped joints and joints of no role are left where they are. No
+  /// allocation.
   void apply(double t, const JointMapping& mapping, Skeleton& skeleton,
              const Eigen::Vector3d& offset = Eigen::Vector3d::Zero()) const;
 

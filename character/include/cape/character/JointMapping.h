@@ -2,11 +2,11 @@
 //
 // The gait speaks in anatomical angles, the same for every model: a positive hip or shoulder angle swings the
 // limb forward, a positive knee angle bends the knee (shin backwards), a positive elbow angle bends the elbow
-// (forearm forwards), a positive ankle angle lifts the toes. A URDF may turn its joints either way, so each role
-// carries a sign, found from the model itself: with the joint turned a little either side of rest, do the links
-// beyond it move forward or backward (URDF +x, seen in the root link's frame)? Hip, ankle, shoulder and elbow
-// want "forward", the knee "backward". A joint that moves its links neither way (its axis is not side to side)
-// cannot be signed and is left unmapped, with a warning.
+// (forearm forwards), a positive ankle angle lifts the toes. A URDF may turn its joints either way, so each
+// role carries a sign, found from the model itself: with the joint turned a little either side of rest, do
+// the links beyond it move forward or backward (URDF +x, seen in the root link's frame)? Hip, ankle, shoulder
+// and elbow want "forward", the knee "backward". A joint that moves its links neither way (its axis is not
+// side to side) cannot be signed and is left unmapped, with a warning.
 #pragma once
 
 #include "cape/character/Urdf.h"
@@ -41,13 +41,14 @@ class JointMapping {
 
   /// Explicit joint names per role (an empty name leaves the role unmapped). A name that is not a movable
   /// joint of the model leaves the role unmapped and adds a warning. Signs are found as described above.
-  static JointMapping fromNames(const UrdfModelPtr& model, const std::array<std::string, kGaitRoleCount>& names);
+  static JointMapping fromNames(const UrdfModelPtr& model,
+                                const std::array<std::string, kGaitRoleCount>& names);
   /// The joint names of the shipped humanoid (character/models/humanoid.urdf).
   static std::array<std::string, kGaitRoleCount> shippedHumanoidNames();
-  /// Recognises common names: a part (hip, knee, ankle, shoulder, elbow) and a side ("left"/"right", an "l_" or
-  /// "r_" prefix, an "_l" or "_r" suffix, or "l"/"r" right before the part, as in "lknee"), case-insensitive;
-  /// only revolute and continuous joints. Where a part has several joints on one side (hip roll, pitch, yaw),
-  /// the one turning most nearly about the side-to-side axis is taken.
+  /// Recognises common names: a part (hip, knee, ankle, shoulder, elbow) and a side ("left"/"right", an "l_"
+  /// or "r_" prefix, an "_l" or "_r" suffix, or "l"/"r" right before the part, as in "lknee"),
+  /// case-insensitive; only revolute and continuous joints. Where a part has several joints on one side (hip
+  /// roll, pitch, yaw), the one turning most nearly about the side-to-side axis is taken.
   static JointMapping byCommonNames(const UrdfModelPtr& model);
   /// The shipped humanoid's names when the model has them all, common names otherwise.
   static JointMapping automatic(const UrdfModelPtr& model);

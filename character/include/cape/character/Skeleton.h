@@ -46,11 +46,12 @@ class Skeleton {
   Status setScale(double scale);
   double scale() const { return scale_; }
 
-  // --- Joint positions (rad for revolute and continuous joints, URDF metres for prismatic ones) ---------------
+  // --- Joint positions (rad for revolute and continuous joints, URDF metres for prismatic ones)
+  // ---------------
   /// Index of a joint, -1 if none.
   int jointIndex(const std::string& name) const { return model_->findJoint(name); }
-  /// Sets a joint's position. Errors: UnknownJoint; NotMovable (fixed, floating, planar); InvalidArgument (not
-  /// finite; nothing changes). A value outside the limits is clamped to them, applied, and reported as
+  /// Sets a joint's position. Errors: UnknownJoint; NotMovable (fixed, floating, planar); InvalidArgument
+  /// (not finite; nothing changes). A value outside the limits is clamped to them, applied, and reported as
   /// OutsideLimits so the caller can tell; every other success returns ok.
   Status setJointPosition(const std::string& name, double q);
   Status setJointPosition(int joint, double q);
@@ -69,15 +70,17 @@ class Skeleton {
   /// Every joint back to its rest position.
   void resetJointPositions();
 
-  // --- Root ----------------------------------------------------------------------------------------------------
-  /// The character frame: `position` in the world (m; the URDF origin, for the shipped humanoid the ground point
-  /// between the feet), `yaw` in rad about world +Y (0 faces -Z, as motionAt in the core's Scene.h).
+  // --- Root
+  // ----------------------------------------------------------------------------------------------------
+  /// The character frame: `position` in the world (m; the URDF origin, for the shipped humanoid the ground
+  /// point between the feet), `yaw` in rad about world +Y (0 faces -Z, as motionAt in the core's Scene.h).
   void setRoot(const Eigen::Vector3d& position, double yaw);
   /// Any rigid character frame (the URDF-to-world rotation is applied inside it).
   void setRootTransform(const Eigen::Isometry3d& root);
   const Eigen::Isometry3d& rootTransform() const { return root_; }
 
-  // --- Poses ---------------------------------------------------------------------------------------------------
+  // --- Poses
+  // ---------------------------------------------------------------------------------------------------
   /// World pose of a link's frame (computed on demand after any change; not safe to call from two threads at
   /// once on one Skeleton).
   const Eigen::Isometry3d& linkPose(int link) const;
@@ -101,7 +104,7 @@ class Skeleton {
   double scale_ = 1.0;
   std::vector<double> q_;
   Eigen::Isometry3d root_ = Eigen::Isometry3d::Identity();
-  std::vector<std::vector<ShapeDesc>> shapes_;  ///< per link, scaled
+  std::vector<std::vector<ShapeDesc>> shapes_;    ///< per link, scaled
   mutable std::vector<Eigen::Isometry3d> poses_;  ///< per link, world
   mutable bool dirty_ = true;
 };

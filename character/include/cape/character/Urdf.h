@@ -1,6 +1,6 @@
-// A URDF robot description loaded with urdfdom into plain data: links with their collision shapes, joints with
-// their origins, axes and limits, in a parents-before-children order. Everything here is in the URDF's own
-// frame and units (REP 103: metres, radians, Z up, X forward); Skeleton maps it into the Y-up world.
+// A URDF robot description loaded with urdfdom into plain data: links with their collision shapes, joints
+// with their origins, axes and limits, in a parents-before-children order. Everything here is in the URDF's
+// own frame and units (REP 103: metres, radians, Z up, X forward); Skeleton maps it into the Y-up world.
 //
 // Loading never throws and never crashes on bad data: it returns a Status (see Status.h) naming the problem.
 // urdfdom prints its diagnostics through console_bridge; while we parse they are captured instead and folded
@@ -18,15 +18,16 @@
 
 namespace cape::character {
 
-/// Collision primitives. URDF (and urdfdom 3.0) has no capsule; mesh elements are not loaded (see warnings()).
+/// Collision primitives. URDF (and urdfdom 3.0) has no capsule; mesh elements are not loaded (see
+/// warnings()).
 enum class ShapeType : int { Sphere, Box, Cylinder };
 const char* toString(ShapeType type);
 
 /// One collision element of a link, in the link's frame.
 struct ShapeDesc {
   ShapeType type = ShapeType::Sphere;
-  double radius = 0.0;                                 ///< m; sphere and cylinder
-  double halfLength = 0.0;                             ///< m; cylinder, along its local z axis (URDF rule)
+  double radius = 0.0;                                    ///< m; sphere and cylinder
+  double halfLength = 0.0;                                ///< m; cylinder, along its local z axis (URDF rule)
   Eigen::Vector3d halfExtents = Eigen::Vector3d::Zero();  ///< m; box, along its local x, y, z
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< shape frame in the link frame
   std::string name;  ///< the element's name attribute, or "<link>#<k>" when it has none
@@ -110,8 +111,8 @@ class UrdfModel {
 };
 
 /// Checks that `text` is well-formed XML with a single root element (tags balanced and matched, attributes
-/// quoted, comments, CDATA, processing instructions and a DOCTYPE allowed). On failure `message` says what and
-/// on which line. Used before urdfdom so that broken XML is told apart from a broken robot description.
+/// quoted, comments, CDATA, processing instructions and a DOCTYPE allowed). On failure `message` says what
+/// and on which line. Used before urdfdom so that broken XML is told apart from a broken robot description.
 bool checkXmlWellFormed(const std::string& text, std::string& message);
 
 }  // namespace cape::character
