@@ -9,15 +9,15 @@ namespace cape::character {
 
 enum class ErrorCode : int {
   Ok = 0,
-  FileNotFound,   ///< The URDF path does not name a readable regular file.
-  MalformedXml,   ///< The text is not well-formed XML (unclosed or mismatched tags, bad attributes, ...).
-  InvalidModel,   ///< Well-formed XML but no valid URDF (no <robot>, a revolute joint without limits, ...).
-  MissingLink,    ///< A joint names a parent or child link that is not defined.
-  NotATree,       ///< No single root, or links unreachable from it: a cycle or a disconnected part.
-  UnknownJoint,   ///< No joint of that name.
-  UnknownLink,    ///< No link of that name.
-  OutsideLimits,  ///< A joint value outside its limits: it was clamped (see the message) and applied.
-  NotMovable,     ///< A fixed (or floating/planar) joint has no single position to set.
+  FileNotFound,     ///< The URDF path does not name a readable regular file.
+  MalformedXml,     ///< The text is not well-formed XML (unclosed or mismatched tags, bad attributes, ...).
+  InvalidModel,     ///< Well-formed XML but no valid URDF (no <robot>, a revolute joint without limits, ...).
+  MissingLink,      ///< A joint names a parent or child link that is not defined.
+  NotATree,         ///< No single root, or links unreachable from it: a cycle or a disconnected part.
+  UnknownJoint,     ///< No joint of that name.
+  UnknownLink,      ///< No link of that name.
+  OutsideLimits,    ///< A joint value outside its limits: it was clamped (see the message) and applied.
+  NotMovable,       ///< A fixed (or floating/planar) joint has no single position to set.
   InvalidArgument,  ///< A non-finite value, a non-positive scale or time step, ...
 };
 
