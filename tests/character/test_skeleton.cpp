@@ -159,3 +159,16 @@ TEST(Skeleton, PositiveHipAngleSwingsTheLegForward) {
   EXPECT_NEAR(knee.z(), -0.40 * std::sin(0.5236), 1e-9);
   EXPECT_NEAR(knee.y(), 0.95 - 0.40 * std::cos(0.5236), 1e-9);
 }
+
+TEST(Skeleton, FloatingJointsHoldTheirOrigin) {
+  // A "world" link with a floating joint to the body, as many robot descriptions have: it loads, the floating
+  // joint has no single position, and the body sits at the joint origin (the root transform places it).
+  Skeleton s = load(R"(<robot name="f">
+    <link name="world"/>
+    <link name="body"><collision><geometry><sphere radius="0.2"/></geometry></collision></link>
+    <joint name="free" type="floating"><parent link="world"/><child link="body"/><origin xyz="0 0 1"/></joint>
+  </robot>)");
+  EXPECT_EQ(s.setJointPosition("free", 0.3).code(), ErrorCode::NotMovable);
+  s.setRoot(Eigen::Vector3d(1, 0, 0), 0.0);
+  EXPECT_TRUE(position(s, "body").isApprox(Eigen::Vector3d(1, 1, 0), 1e-12));
+}
