@@ -122,6 +122,18 @@ TEST(SelfCollision, SwitchedOffTheSolverIsBitForBitUnchanged) {
   EXPECT_EQ(b.cape().selfContactCount(), 0u);
 }
 
+// A wild velocity (a teleport handled by hand, a user's bug) makes every search box huge: the search falls
+// back to bounded brute force instead of walking millions of cells, and nothing turns non-finite.
+TEST(SelfCollision, HugeMotionStaysBoundedAndFinite) {
+  CapeSettings s;
+  s.selfCollision = true;
+  SimpleScene scene(SceneKind::Walk, 12, Attachment::Corners, s);
+  Points& v = scene.cape().mutableState().velocities;
+  for (Eigen::Index i = 0; i < v.rows(); i += 2) v.row(i) << 400.0f, -300.0f, 500.0f;
+  for (int f = 0; f < 5; ++f) scene.advanceFrame();
+  EXPECT_TRUE(scene.cape().state().positions.allFinite());
+}
+
 TEST(SelfCollision, BadThicknessIsRejected) {
   CapeSettings s;
   s.selfCollision = true;

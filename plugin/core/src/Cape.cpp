@@ -85,9 +85,12 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   while (buckets < 2 * static_cast<std::uint32_t>(n)) buckets <<= 1;
   hashStart_.assign(buckets + 1, 0u);
   hashEntries_.assign(8 * fabric_->triangleCount(), 0u);
-  triangleBoxes_.assign(6 * fabric_->triangleCount(), 0.0f);
+  triangleBoxes_.assign(8 * fabric_->triangleCount(), 0.0f);
+  triangleStamp_.assign(fabric_->triangleCount(), 0u);
+  largeTriangles_.reserve(fabric_->triangleCount());
   stepMotion_ = Points::Zero(n, 3);
   stepMotionNorm_ = Eigen::VectorXf::Zero(n);
+  selfWeight_ = Eigen::VectorXf::Zero(n);
   selfContacts_.reserve(static_cast<std::size_t>(32 * n));
   {
     const SpringSet& structural = fabric_->springs(SpringFamily::Structural);
@@ -217,23 +220,28 @@ void Cape::accumulateExternalAcceleration() {
     }
   } else if (wind.model == WindSettings::Model::Aerodynamic) {
     // Per triangle, from the air's velocity relative to the triangle (averages of its corners); a third of
-    // the force goes to each corner.
+    // the force goes to each corner. Flat arrays: this loop runs once per substep over every triangle.
     const std::vector<std::uint32_t>& tri = fabric_->triangles();
-    const Points& x = state_.positions;
-    const Points& v = state_.velocities;
+    const float *px = state_.positions.col(0).data(), *py = state_.positions.col(1).data(), *pz = state_.positions.col(2).data();
+    const float *vx = state_.velocities.col(0).data(), *vy = state_.velocities.col(1).data(), *vz = state_.velocities.col(2).data();
+    const float *ux = airVelocity_.col(0).data(), *uy = airVelocity_.col(1).data(), *uz = airVelocity_.col(2).data();
+    float *ax = acceleration_.col(0).data(), *ay = acceleration_.col(1).data(), *az = acceleration_.col(2).data();
     const float* w = state_.inverseMasses.data();
+    const float rho = wind.airDensity, cd = wind.dragCoefficient, cl = wind.liftCoefficient;
     for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
       const std::uint32_t i = tri[t], j = tri[t + 1], k = tri[t + 2];
-      const Vec3 xi = x.row(i).transpose();
-      const Vec3 areaNormal = 0.5f * (x.row(j).transpose() - xi).cross(x.row(k).transpose() - xi);
-      const Vec3 u = ((airVelocity_.row(i) + airVelocity_.row(j) + airVelocity_.row(k)) -
-                      (v.row(i) + v.row(j) + v.row(k)))
-                         .transpose() /
-                     3.0f;
-      const Vec3 third = aerodynamicForce(u, areaNormal, wind.airDensity, wind.dragCoefficient, wind.liftCoefficient) / 3.0f;
-      acceleration_.row(i) += w[i] * third.transpose();
-      acceleration_.row(j) += w[j] * third.transpose();
-      acceleration_.row(k) += w[k] * third.transpose();
+      const Vec3 e1(px[j] - px[i], py[j] - py[i], pz[j] - pz[i]);
+      const Vec3 e2(px[k] - px[i], py[k] - py[i], pz[k] - pz[i]);
+      const Vec3 areaNormal = 0.5f * e1.cross(e2);
+      const Vec3 u((ux[i] + ux[j] + ux[k] - vx[i] - vx[j] - vx[k]) * (1.0f / 3.0f),
+                   (uy[i] + uy[j] + uy[k] - vy[i] - vy[j] - vy[k]) * (1.0f / 3.0f),
+                   (uz[i] + uz[j] + uz[k] - vz[i] - vz[j] - vz[k]) * (1.0f / 3.0f));
+      const Vec3 third = aerodynamicForce(u, areaNormal, rho, cd, cl) * (1.0f / 3.0f);
+      for (const std::uint32_t c : {i, j, k}) {
+        ax[c] += w[c] * third.x();
+        ay[c] += w[c] * third.y();
+        az[c] += w[c] * third.z();
+      }
     }
   }
 }
@@ -251,12 +259,19 @@ void Cape::stepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
   for (int it = 0; it < settings_.iterations; ++it) {
     if (settings_.useTethers) solveTethers();
     solveSprings(h);
-    if (settings_.selfCollision) solveSelfContacts();
+    if (settings_.selfCollision) solveSelfContacts(state_.inverseMasses.data());
   }
   collide(h, s0, s1, colliders, false);
   // A particle wedged where two colliders meet (a shoulder sphere poking out of the torso box) is pushed out
   // of one into the other; a few Gauss-Seidel passes over the contacts settle it outside both.
   for (int pass = 0; pass < kContactPasses; ++pass) reprojectContacts(colliders);
+  if (settings_.selfCollision) {
+    // Cloth pressed between a body and another layer of itself: the layer on the body cannot give way, so
+    // the outer layer takes the whole correction (mass scaling by contact).
+    selfWeight_ = state_.inverseMasses;
+    for (const Contact& k : contacts_) selfWeight_[k.particle] = 0.0f;
+    solveSelfContacts(selfWeight_.data());
+  }
   // New velocities from the position change, then damping: dv/dt = -c v integrated implicitly
   // (v <- v / (1 + c h), the Padé approximation of exp(-c h), unconditionally stable).
   const float scale = 1.0f / (h * (1.0f + settings_.damping * h));

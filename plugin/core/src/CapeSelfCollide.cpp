@@ -82,6 +82,8 @@ inline std::uint32_t bucketOf(int ix, int iy, int iz, std::uint32_t mask) {
 void Cape::findSelfContacts(float dt) {
   selfContacts_.clear();
   const Points& x = state_.positions;
+  // A cape that is no longer finite has blown up (the metrics report it); there is nothing to keep apart.
+  if (!x.allFinite() || !state_.velocities.allFinite()) return;
   const Eigen::Index n = x.rows();
   const float thickness = settings_.selfCollisionThickness;
 
@@ -94,33 +96,54 @@ void Cape::findSelfContacts(float dt) {
   stepMotion_.rowwise() -= mean;
   Eigen::VectorXf& motion = stepMotionNorm_;
   motion = stepMotion_.rowwise().norm();  // same size every step: no allocation
-  const float maxMotion = motion.maxCoeff();
 
   // A pair can close in by at most their relative motion; the solver's own corrections (springs, collisions)
   // add some more, which one more thickness and a quarter of the spacing allow for.
   const float slack = thickness + 0.25f * meanSpacing_;
 
-  // Bin the triangles, each grown by how far a particle could come at it, into the cells of a hashed grid;
-  // then each particle looks in its own cell only. Cells twice the spacing: a triangle spans one or two per
-  // axis.
+  // Bin the triangles, each grown by the thickness, the slack and its own motion, into the cells of a hashed
+  // grid; each particle then visits the cells of its own motion's box. Cells twice the spacing: a triangle
+  // spans one or two per axis.
   const std::vector<std::uint32_t>& tri = fabric_->triangles();
   const std::size_t triangles = tri.size() / 3;
   const float cell = 2.0f * meanSpacing_;
   const float invCell = 1.0f / cell;
   const std::uint32_t buckets = static_cast<std::uint32_t>(hashStart_.size() - 1);
   const std::uint32_t mask = buckets - 1;
-  auto cellOf = [invCell](float v) { return static_cast<int>(std::floor(v * invCell)); };
+  // floor() is a library call in a portable (pre-SSE4.1) build: truncate and correct instead.
+  auto cellOf = [invCell](float v) {
+    const float f = v * invCell;
+    const int i = static_cast<int>(f);
+    return i - (f < static_cast<float>(i) ? 1 : 0);
+  };
+  // A box spanning more cells than this per axis (a fast or huge motion) is not binned: such triangles go on
+  // a list every particle checks, and such a particle checks every triangle. Bounded work, whatever the motion.
+  constexpr int kMaxSpan = 6;
+  auto spans = [&](const Vec3& lo, const Vec3& hi) {
+    return cellOf(hi.x()) - cellOf(lo.x()) > kMaxSpan || cellOf(hi.y()) - cellOf(lo.y()) > kMaxSpan ||
+           cellOf(hi.z()) - cellOf(lo.z()) > kMaxSpan;
+  };
+  largeTriangles_.clear();
   std::fill(hashStart_.begin(), hashStart_.end(), 0u);
   for (std::size_t t = 0; t < triangles; ++t) {
     const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
     const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
-    const float reach = thickness + slack + std::max({motion[ia], motion[ib], motion[ic]}) + maxMotion;
-    const Vec3 lo = a.cwiseMin(b).cwiseMin(c).array() - reach;
-    const Vec3 hi = a.cwiseMax(b).cwiseMax(c).array() + reach;
-    float* box = &triangleBoxes_[6 * t];
+    const float triMotion = std::max({motion[ia], motion[ib], motion[ic]});
+    const float grow = thickness + slack + triMotion;
+    const Vec3 lo = a.cwiseMin(b).cwiseMin(c).array() - grow;
+    const Vec3 hi = a.cwiseMax(b).cwiseMax(c).array() + grow;
+    float* box = &triangleBoxes_[8 * t];
     for (int k = 0; k < 3; ++k) {
       box[k] = lo[k];
       box[3 + k] = hi[k];
+    }
+    // A bounding sphere for a quick rejection: about the centroid, out to the farthest corner.
+    const Vec3 centroid = (a + b + c) / 3.0f;
+    box[6] = triMotion;
+    box[7] = std::sqrt(std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()}));
+    if (spans(lo, hi)) {
+      largeTriangles_.push_back(static_cast<std::uint32_t>(t));
+      continue;
     }
     for (int ix = cellOf(lo.x()); ix <= cellOf(hi.x()); ++ix)
       for (int iy = cellOf(lo.y()); iy <= cellOf(hi.y()); ++iy)
@@ -130,48 +153,66 @@ void Cape::findSelfContacts(float dt) {
   if (hashEntries_.size() < hashStart_[buckets]) hashEntries_.resize(hashStart_[buckets]);  // grows rarely
   // Fill in triangle order (deterministic), each bucket's start serving as its cursor...
   for (std::size_t t = 0; t < triangles; ++t) {
-    const float* box = &triangleBoxes_[6 * t];
-    for (int ix = cellOf(box[0]); ix <= cellOf(box[3]); ++ix)
-      for (int iy = cellOf(box[1]); iy <= cellOf(box[4]); ++iy)
-        for (int iz = cellOf(box[2]); iz <= cellOf(box[5]); ++iz)
+    const float* box = &triangleBoxes_[8 * t];
+    const Vec3 lo(box[0], box[1], box[2]), hi(box[3], box[4], box[5]);
+    if (spans(lo, hi)) continue;
+    for (int ix = cellOf(lo.x()); ix <= cellOf(hi.x()); ++ix)
+      for (int iy = cellOf(lo.y()); iy <= cellOf(hi.y()); ++iy)
+        for (int iz = cellOf(lo.z()); iz <= cellOf(hi.z()); ++iz)
           hashEntries_[hashStart_[bucketOf(ix, iy, iz, mask)]++] = static_cast<std::uint32_t>(t);
   }
   // ...which leaves [b] at the end of bucket b: shift back so bucket b is [hashStart_[b], hashStart_[b + 1]).
   for (std::uint32_t b = buckets; b > 0; --b) hashStart_[b] = hashStart_[b - 1];
   hashStart_[0] = 0;
 
+  // One particle against one triangle: the exact filter, and the contact with the side it is on.
+  auto consider = [&](std::uint32_t q, const Vec3& p, float mq, std::uint32_t t) {
+    if (triangleStamp_[t] == q) return;  // met already through another cell
+    triangleStamp_[t] = q;
+    const float* box = &triangleBoxes_[8 * t];
+    if (p.x() + mq < box[0] || p.y() + mq < box[1] || p.z() + mq < box[2] || p.x() - mq > box[3] || p.y() - mq > box[4] ||
+        p.z() - mq > box[5])
+      return;
+    const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
+    if (q == ia || q == ib || q == ic) return;
+    const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
+    const float reach = thickness + slack + mq + box[6] + box[7];
+    if ((p - (a + b + c) / 3.0f).squaredNorm() > reach * reach) return;
+    const Nearest w = nearestOnTriangle(p, a, b, c);
+    const Vec3 nearest = w.wa * a + w.wb * b + w.wc * c;
+    // How much closer the two may come: the particle's motion relative to the triangle's corners.
+    const Vec3 mqv = stepMotion_.row(q).transpose();
+    const float closing = std::sqrt(std::max({(mqv - stepMotion_.row(ia).transpose()).squaredNorm(),
+                                              (mqv - stepMotion_.row(ib).transpose()).squaredNorm(),
+                                              (mqv - stepMotion_.row(ic).transpose()).squaredNorm()}));
+    if ((p - nearest).norm() > thickness + slack + closing) return;
+    float side = 0.0f, wa, wb, wc;
+    if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc))
+      side = (b - a).cross(c - a).dot(p - a) >= 0.0f ? 1.0f : -1.0f;
+    selfContacts_.push_back({q, t, side});
+  };
+
+  std::fill(triangleStamp_.begin(), triangleStamp_.end(), ~0u);
   for (Eigen::Index qi = 0; qi < n; ++qi) {
     const std::uint32_t q = static_cast<std::uint32_t>(qi);
     const Vec3 p = at(x, q);
-    const std::uint32_t bucket = bucketOf(cellOf(p.x()), cellOf(p.y()), cellOf(p.z()), mask);
-    std::uint32_t previous = ~0u;
-    for (std::uint32_t e = hashStart_[bucket]; e < hashStart_[bucket + 1]; ++e) {
-      const std::uint32_t t = hashEntries_[e];
-      if (t == previous) continue;  // two cells of one triangle hashed to this bucket: entries are adjacent
-      previous = t;
-      const float* box = &triangleBoxes_[6 * t];
-      if (p.x() < box[0] || p.y() < box[1] || p.z() < box[2] || p.x() > box[3] || p.y() > box[4] || p.z() > box[5]) continue;
-      const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
-      if (q == ia || q == ib || q == ic) continue;
-      const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
-      const Nearest w = nearestOnTriangle(p, a, b, c);
-      const Vec3 nearest = w.wa * a + w.wb * b + w.wc * c;
-      // How much closer the two may come: the particle's motion relative to the triangle's corners.
-      const Vec3 mq = stepMotion_.row(q).transpose();
-      const float closing = std::max({(mq - stepMotion_.row(ia).transpose()).norm(), (mq - stepMotion_.row(ib).transpose()).norm(),
-                                      (mq - stepMotion_.row(ic).transpose()).norm()});
-      if ((p - nearest).norm() > thickness + slack + closing) continue;
-      float side = 0.0f, wa, wb, wc;
-      if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc))
-        side = (b - a).cross(c - a).dot(p - a) >= 0.0f ? 1.0f : -1.0f;
-      selfContacts_.push_back({q, t, side});
+    const float mq = motion[q];
+    if (spans(p.array() - mq, p.array() + mq)) {
+      for (std::size_t t = 0; t < triangles; ++t) consider(q, p, mq, static_cast<std::uint32_t>(t));
+      continue;
     }
+    for (int ix = cellOf(p.x() - mq); ix <= cellOf(p.x() + mq); ++ix)
+      for (int iy = cellOf(p.y() - mq); iy <= cellOf(p.y() + mq); ++iy)
+        for (int iz = cellOf(p.z() - mq); iz <= cellOf(p.z() + mq); ++iz) {
+          const std::uint32_t bucket = bucketOf(ix, iy, iz, mask);
+          for (std::uint32_t e = hashStart_[bucket]; e < hashStart_[bucket + 1]; ++e) consider(q, p, mq, hashEntries_[e]);
+        }
+    for (const std::uint32_t t : largeTriangles_) consider(q, p, mq, t);
   }
 }
 
-void Cape::solveSelfContacts() {
+void Cape::solveSelfContacts(const float* w) {
   Points& x = state_.positions;
-  const float* w = state_.inverseMasses.data();
   const float thickness = settings_.selfCollisionThickness;
   const std::vector<std::uint32_t>& tri = fabric_->triangles();
   for (SelfContact& k : selfContacts_) {

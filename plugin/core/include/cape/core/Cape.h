@@ -80,7 +80,7 @@ class Cape {
   void solveTethers();
   void accumulateExternalAcceleration();
   void findSelfContacts(float dt);
-  void solveSelfContacts();
+  void solveSelfContacts(const float* inverseMasses);
 
   FabricPtr fabric_;
   CapeSettings settings_;
@@ -112,8 +112,11 @@ class Cape {
   std::vector<SelfContact> selfContacts_;
   std::vector<std::uint32_t> hashStart_;     ///< Spatial hash: bucket offsets (buckets + 1).
   std::vector<std::uint32_t> hashEntries_;   ///< Spatial hash: triangles sorted by bucket.
-  std::vector<float> triangleBoxes_;         ///< Grown bounding box of each triangle (lo xyz, hi xyz), m.
+  std::vector<float> triangleBoxes_;         ///< Per triangle: grown box (lo xyz, hi xyz), motion, radius, m.
+  std::vector<std::uint32_t> triangleStamp_; ///< Last particle that met each triangle in the search.
+  std::vector<std::uint32_t> largeTriangles_; ///< Triangles whose grown box is too big to bin.
   Points stepMotion_;                        ///< Predicted displacement over the step, less the mean, m.
+  Eigen::VectorXf selfWeight_;               ///< Inverse masses for the last self-contact pass, 1/kg.
   Eigen::VectorXf stepMotionNorm_;           ///< |stepMotion_| per particle, m.
   float meanSpacing_ = 0.0f;                 ///< Mean structural rest length, m (sizes the hash cells).
 };
