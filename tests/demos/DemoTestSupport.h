@@ -1,0 +1,59 @@
+// Running a demo binary from a test: its exit status and everything it printed, in a fresh folder.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+namespace cape::demo_test {
+
+struct Result {
+  int exitCode = -1;
+  std::string output;  ///< stdout and stderr together
+};
+
+/// Runs `command` through the shell with stderr folded into stdout.
+inline Result run(const std::string& command) {
+  Result r;
+  std::FILE* p = popen((command + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, p)) > 0) r.output.append(buffer, n);
+  const int status = pclose(p);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+/// A fresh, empty folder under the build's temporary directory, named after the running test.
+inline std::filesystem::path freshDir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / "cape_demo_tests" /
+                              (std::string(info->test_suite_name()) + "." + info->name());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+inline std::vector<std::string> lines(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) out.push_back(line);
+  return out;
+}
+
+/// Counts lines of an OBJ file starting with `prefix` ("v ", "vn ", "vt ", "f ").
+inline int countPrefixed(const std::filesystem::path& file, const std::string& prefix) {
+  int count = 0;
+  for (const std::string& l : lines(file)) count += l.rfind(prefix, 0) == 0 ? 1 : 0;
+  return count;
+}
+
+}  // namespace cape::demo_test

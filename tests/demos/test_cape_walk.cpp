@@ -1,0 +1,116 @@
+// cape_walk end to end: a short scene runs, and metrics.csv, summary.json, frames/*.obj and colliders.jsonl
+// hold what the README says (rows = frames, OBJ vertices = particles, JSONL lines = frames); bad options
+// fail with a non-zero exit and a one-line reason.
+#include "DemoTestSupport.h"
+
+namespace cape::demo_test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::string kWalk = CAPE_WALK;
+
+void expectRunFolder(const fs::path& dir, int frames, int n, int characters, int collidersPerCharacter) {
+  // metrics.csv: a header and one row per frame, every column filled.
+  const std::vector<std::string> csv = lines(dir / "metrics.csv");
+  ASSERT_EQ(static_cast<int>(csv.size()), frames + 1);
+  const auto columns = [](const std::string& l) { return 1 + std::count(l.begin(), l.end(), ','); };
+  for (const std::string& l : csv) EXPECT_EQ(columns(l), columns(csv[0]));
+  for (const char* name : {"frame", "max_strain", "mean_strain", "max_penetration_m", "self_intersections", "pin_error_m", "blow_up"})
+    EXPECT_NE(csv[0].find(name), std::string::npos) << name << " missing from " << csv[0];
+
+  // colliders.jsonl: one object per frame, every collider with its type's fields.
+  const std::vector<std::string> jsonl = lines(dir / "colliders.jsonl");
+  ASSERT_EQ(static_cast<int>(jsonl.size()), frames);
+  for (int f = 0; f < frames; ++f) {
+    const json j = json::parse(jsonl[static_cast<std::size_t>(f)]);
+    EXPECT_EQ(j["frame"].get<int>(), f + 1);
+    ASSERT_EQ(static_cast<int>(j["colliders"].size()), characters * collidersPerCharacter);
+    for (const json& c : j["colliders"]) {
+      const std::string type = c["type"];
+      EXPECT_TRUE(c.contains("name") && c.contains("position") && c.contains("rotation")) << c.dump();
+      EXPECT_EQ(c["rotation"].size(), 4u);
+      if (type == "sphere") {
+        EXPECT_TRUE(c.contains("radius"));
+      } else if (type == "box") {
+        EXPECT_EQ(c["half_extents"].size(), 3u);
+      } else if (type == "capsule" || type == "cylinder") {
+        EXPECT_TRUE(c.contains("half_height") && c.contains("axis") && c.contains("radius"));
+      } else {
+        ADD_FAILURE() << "unknown collider type " << type;
+      }
+    }
+  }
+
+  // frames/NNNNN.obj: one per frame (per character in a crowd), n * n vertices, normals, UVs, 2 (n-1)^2 faces.
+  for (int k = 0; k < characters; ++k) {
+    const fs::path folder = characters > 1 ? dir / "frames" / ("k" + std::to_string(k)) : dir / "frames";
+    for (int f : {1, frames}) {
+      char name[32];
+      std::snprintf(name, sizeof name, "%05d.obj", f);
+      const fs::path obj = folder / name;
+      ASSERT_TRUE(fs::exists(obj)) << obj;
+      EXPECT_EQ(countPrefixed(obj, "v "), n * n);
+      EXPECT_EQ(countPrefixed(obj, "vn "), n * n);
+      EXPECT_EQ(countPrefixed(obj, "vt "), n * n);
+      EXPECT_EQ(countPrefixed(obj, "f "), 2 * (n - 1) * (n - 1));
+    }
+    EXPECT_EQ(std::distance(fs::directory_iterator(folder), fs::directory_iterator()), frames);
+  }
+
+  // summary.json: the scene, the grid, the settings and the summary figures.
+  std::ifstream in(dir / "summary.json");
+  const json s = json::parse(in);
+  EXPECT_EQ(s["grid"]["particles"].get<int>(), n * n);
+  EXPECT_EQ(s["characters"].get<int>(), characters);
+  for (const char* key : {"frame_time_us_median", "cape_time_us_median", "max_strain", "max_penetration_m",
+                          "frames_penetration_over_1mm", "self_intersections_max", "pin_error_max_m", "blow_up"})
+    EXPECT_TRUE(s["summary"].contains(key)) << key;
+  EXPECT_FALSE(s["summary"]["blow_up"].get<bool>());
+}
+
+TEST(CapeWalk, SimpleBodyWalkWritesEveryOutput) {
+  const fs::path dir = freshDir();
+  const Result r = run(kWalk + " --simple-body --scene walk --size 8 --seconds 0.5 --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("strain"), std::string::npos) << "prints a summary table";
+  expectRunFolder(dir, 30, 8, 1, 5);
+}
+
+TEST(CapeWalk, CrowdWritesFramesPerCharacter) {
+  const fs::path dir = freshDir();
+  const Result r = run(kWalk + " --simple-body --scene crowd --characters 3 --size 6 --seconds 0.25 --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  expectRunFolder(dir, 15, 6, 3, 5);
+}
+
+TEST(CapeWalk, NoFramesWritesNoObj) {
+  const fs::path dir = freshDir();
+  const Result r = run(kWalk + " --simple-body --size 6 --seconds 0.1 --no-frames --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "frames"));
+  EXPECT_EQ(lines(dir / "metrics.csv").size(), 7u);
+}
+
+TEST(CapeWalk, HelpListsTheOptions) {
+  const Result r = run(kWalk + " --help");
+  EXPECT_EQ(r.exitCode, 0);
+  for (const char* option : {"--scene", "--size", "--attachment", "--seconds", "--solver", "--characters", "--threads",
+                             "--out", "--no-frames", "--simple-body", "--urdf", "--attach"})
+    EXPECT_NE(r.output.find(option), std::string::npos) << option;
+}
+
+TEST(CapeWalk, BadOptionsFailWithAReason) {
+  const fs::path dir = freshDir();
+  for (const std::string args : {"--scene dance", "--size 0", "--seconds -1", "--urdf /nonexistent/robot.urdf",
+                                 "--solver magic", "--attachment belt", "--frobnicate"}) {
+    const Result r = run(kWalk + " " + args + " --out " + (dir / "x").string());
+    EXPECT_NE(r.exitCode, 0) << args;
+    EXPECT_FALSE(r.output.empty()) << args << ": no reason given";
+    EXPECT_LE(std::count(r.output.begin(), r.output.end(), '\n'), 3) << args << ": a short reason, not a dump:\n" << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace cape::demo_test
