@@ -175,17 +175,19 @@ void Cape::findSelfContacts(float dt) {
       return;
     const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
     if (q == ia || q == ib || q == ic) return;
-    const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
-    const float reach = thickness + slack + mq + box[6] + box[7];
-    if ((p - (a + b + c) / 3.0f).squaredNorm() > reach * reach) return;
-    const Nearest w = nearestOnTriangle(p, a, b, c);
-    const Vec3 nearest = w.wa * a + w.wb * b + w.wc * c;
     // How much closer the two may come: the particle's motion relative to the triangle's corners.
     const Vec3 mqv = stepMotion_.row(q).transpose();
     const float closing = std::sqrt(std::max({(mqv - stepMotion_.row(ia).transpose()).squaredNorm(),
                                               (mqv - stepMotion_.row(ib).transpose()).squaredNorm(),
                                               (mqv - stepMotion_.row(ic).transpose()).squaredNorm()}));
-    if ((p - nearest).norm() > thickness + slack + closing) return;
+    const float within = thickness + slack + closing;
+    // The bounding sphere first: it rejects the cape's own neighbourhood (near, but moving along) cheaply.
+    const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
+    const float reach = within + box[7];
+    if ((p - (a + b + c) / 3.0f).squaredNorm() > reach * reach) return;
+    const Nearest w = nearestOnTriangle(p, a, b, c);
+    const Vec3 nearest = w.wa * a + w.wb * b + w.wc * c;
+    if ((p - nearest).squaredNorm() > within * within) return;
     float side = 0.0f, wa, wb, wc;
     if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc))
       side = (b - a).cross(c - a).dot(p - a) >= 0.0f ? 1.0f : -1.0f;
