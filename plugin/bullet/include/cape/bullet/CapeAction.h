@@ -1,0 +1,217 @@
+// CapeAction: one cape stepping with a Bullet world. `world->addAction(&action)` is all it takes: Bullet
+// calls updateAction() once per internal fixed step, after the rigid bodies have moved, and the action
+// converts what it needs (pin targets from the bodies it is attached to, colliders from the bodies it
+// touches) and delegates the step to cape::Cape.
+//
+// Ownership (Bullet's rule): the user owns the bodies, removes them from the world before deleting them,
+// and removes the action from the world before destroying it. The action never dereferences a body that
+// is no longer in the world: at the start of every update it compares the pointers it holds against the
+// world's collision object array (pointers only) and drops every attachment and collider whose body is
+// gone, releasing its particles, with one warning per body. So removing a body (and deleting it) between
+// two stepSimulation calls is safe; calling detach(body) first is the tidy way and warns about nothing.
+#pragma once
+
+#include "cape/bullet/ShapeColliders.h"
+#include "cape/core/Cape.h"
+
+#include <BulletDynamics/Dynamics/btActionInterface.h>
+#include <BulletDynamics/Dynamics/btRigidBody.h>
+#include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+class btCollisionWorld;
+class btIDebugDraw;
+
+namespace cape::bullet {
+
+/// Receives the adapter's warnings (unsupported shapes, bodies removed while attached). Default: stderr.
+using WarningHandler = std::function<void(const std::string&)>;
+
+/// Per-action parameters, plain data with units.
+struct CapeActionSettings {
+  /// Find colliders automatically: every collision object whose broadphase AABB overlaps the cape's
+  /// bounds (grown by discoveryMargin) and whose filter accepts the cape's group and mask (Bullet's rule:
+  /// (object.group & cape.mask) != 0 and (cape.group & object.mask) != 0). Objects without contact
+  /// response (CF_NO_CONTACT_RESPONSE: triggers, ghosts) and soft bodies are skipped.
+  bool discoverColliders = true;
+  int collisionGroup = btBroadphaseProxy::DefaultFilter;
+  int collisionMask = btBroadphaseProxy::AllFilter;
+  /// m: how far beyond the cape's particle bounds discovery looks; covers a step's motion of fast bodies.
+  btScalar discoveryMargin = btScalar(0.25);
+
+  /// How much of the reference body's motion the free particles feel, 0..1 (character-cloth "inertia").
+  /// 1: all of it (plain physics). 0: the cape rides along with the body's frame as if glued to it, feeling
+  /// none of its acceleration. Implemented as a change of frame before each step: every particle (and the
+  /// start of every pin's sweep) moves by (1 - inertia) of the reference body's displacement (linear) and of
+  /// its rotation about its origin (angular) over the step; velocities turn with that rotation.
+  btScalar linearInertia = btScalar(1);
+  btScalar angularInertia = btScalar(1);
+
+  /// A reference body moving farther than this in one step (m), or turning more than teleportAngle (rad),
+  /// teleports: the whole cape is moved rigidly with it (Cape::teleport) and no collider is swept.
+  btScalar teleportDistance = btScalar(1);
+  btScalar teleportAngle = btScalar(1.0);
+};
+
+/// One particle pinned to a rigid body at a point in the body's frame.
+struct Attachment {
+  std::uint32_t particle = 0;
+  const btRigidBody* body = nullptr;  ///< Never dereferenced once the body left the world.
+  btVector3 localPivot{0, 0, 0};      ///< m, in the body's frame.
+};
+
+class CapeAction : public btActionInterface {
+ public:
+  static constexpr std::uint32_t kNoParticle = 0xffffffffu;
+
+  /// A cape at the fabric's rest shape placed by `placement` (world = placement * rest), at rest.
+  /// Check ok(): on bad fabric or settings the cape is empty and updates do nothing.
+  CapeAction(FabricPtr fabric, const CapeSettings& settings, const btTransform& placement = btTransform::getIdentity(),
+             const CapeActionSettings& actionSettings = CapeActionSettings());
+  ~CapeAction() override;
+  CapeAction(const CapeAction&) = delete;
+  CapeAction& operator=(const CapeAction&) = delete;
+
+  bool ok() const { return cape_.ok(); }
+  const Cape& cape() const { return cape_; }
+  /// The core cape (settings, pins, state). Prefer the attach/detach methods for body pins.
+  Cape& cape() { return cape_; }
+  const CapeActionSettings& actionSettings() const { return settings_; }
+  void setActionSettings(const CapeActionSettings& settings) { settings_ = settings; }
+  void setWarningHandler(WarningHandler handler) { warn_ = std::move(handler); }
+
+  // --- Attachments --------------------------------------------------------------------------------------
+  /// Pins `particle` to `body` at `localPivot` (m, body frame); the particle jumps there at the next step.
+  /// Re-attaching an attached particle moves its attachment. False on a bad particle or null body.
+  bool attach(std::uint32_t particle, const btRigidBody* body, const btVector3& localPivot);
+  /// Pins `particle` to `body` where the particle is now.
+  bool attach(std::uint32_t particle, const btRigidBody* body);
+  /// Pins the particle nearest to `worldPoint` to `body` at that point. Returns the particle (kNoParticle
+  /// on failure).
+  std::uint32_t attachNearest(const btRigidBody* body, const btVector3& worldPoint);
+  /// Pins a whole grid row (row 0 is the top; fabrics built by Fabric::grid only) where its particles are
+  /// now. Returns how many particles were attached.
+  std::size_t attachRow(int row, const btRigidBody* body);
+  /// Releases a particle (it falls freely again).
+  void detach(std::uint32_t particle);
+  /// Releases every particle attached to `body` (call before deleting an attached body). Compares
+  /// pointers only, so it is safe with a body already deleted.
+  void detach(const btCollisionObject* body);
+  void detachAll();
+  const std::vector<Attachment>& attachments() const { return attachments_; }
+  /// The body whose motion inertia and teleports refer to: set here, else the first attachment's body.
+  void setReferenceBody(const btRigidBody* body) { referenceBody_ = body; }
+
+  // --- Colliders ---------------------------------------------------------------------------------------
+  /// Always collide with `object` (whether or not discovery is on or would find it).
+  void addCollider(const btCollisionObject* object);
+  /// Stop colliding with an object added by addCollider (discovery may still find it).
+  void removeCollider(const btCollisionObject* object);
+  /// The core colliders of the last step (poses at its start and end), for drawing, metrics and tests.
+  const std::vector<Collider>& coreColliders() const { return colliders_; }
+  /// The collision objects whose shapes were used in the last step (in a deterministic order).
+  const std::vector<const btCollisionObject*>& activeObjects() const { return activeObjects_; }
+  /// Convex shapes handled by GJK and concave shapes by triangles in the last step.
+  std::size_t gjkShapeCount() const { return convexParts_.size(); }
+  std::size_t meshShapeCount() const { return concaveParts_.size(); }
+
+  // --- Stepping ----------------------------------------------------------------------------------------
+  /// One internal step of the world (dt s): prepare() then advance().
+  void updateAction(btCollisionWorld* world, btScalar dt) override;
+  /// Draws every triangle's edges (m, world) in the colour given.
+  void debugDraw(btIDebugDraw* drawer) override;
+  void setDebugColor(const btVector3& color) { debugColor_ = color; }
+
+  /// The two halves of updateAction, for CapeGroup: prepare() reads the world (bodies still present,
+  /// their poses, collider discovery) and must run on one thread; advance() touches only this cape and
+  /// the shapes' read-only data, so several capes may advance at once on different threads.
+  void prepare(btCollisionWorld* world, btScalar dt);
+  void advance(btScalar dt);
+
+  // --- Results -----------------------------------------------------------------------------------------
+  std::size_t particleCount() const { return cape_.ok() ? cape_.fabric().particleCount() : 0; }
+  /// Particle positions, m, world (one row per particle, columns x, y, z).
+  const Points& positions() const { return cape_.state().positions; }
+  btVector3 position(std::uint32_t particle) const;
+  /// Wall time of the last advance() (the cape's own work in one internal step), microseconds.
+  double lastStepMicroseconds() const { return lastStepMicroseconds_; }
+  /// Wall time of every advance() since the last call of this function, microseconds (a frame's cape time
+  /// when called once per stepSimulation).
+  double takeAccumulatedMicroseconds();
+  /// True when the last step teleported the cape.
+  bool teleportedLastStep() const { return teleported_; }
+  /// Internal steps taken so far.
+  std::uint64_t stepCount() const { return stepCount_; }
+
+ private:
+  /// A collision object the action follows: an attachment body, a collider, or both.
+  struct Tracked {
+    const btCollisionObject* object = nullptr;
+    btTransform lastSeen;       ///< Its world transform when last read.
+    btTransform segmentStart;   ///< The motion being spread over internal steps: from here...
+    btTransform segmentEnd;     ///< ...to here,
+    btScalar segmentDuration = 0;  ///< over this long, s (from the body's velocity; 0: at once).
+    btScalar segmentElapsed = 0;   ///< s spent of it so far.
+    btTransform stepStart;      ///< Pose at the start of this internal step.
+    btTransform stepEnd;        ///< Pose at the end of this internal step.
+    bool jumped = false;        ///< Teleported in this step: no sweep.
+    bool explicitCollider = false;
+    bool discovered = false;    ///< Found by discovery for this step.
+    bool converted = false;
+    ShapeConversion shape;
+  };
+
+  Tracked& track(const btCollisionObject* object);
+  Tracked* find(const btCollisionObject* object);
+  void dropMissing(btCollisionWorld* world);
+  void discover(btCollisionWorld* world);
+  void advancePoses(btScalar dt);
+  void applyTeleport();
+  void applyInertia();
+  void updatePins();
+  void buildColliders();
+  void convexPass(btScalar dt);
+  void concavePass(btScalar dt);
+  void respond(Eigen::Index particle, const Vec3& normal, float pushDistance, btScalar dt);
+  void refreshPinIndices();
+  void warnOnce(const std::string& key, const std::string& message);
+  const btRigidBody* referenceBody() const;
+
+  Cape cape_;
+  CapeActionSettings settings_;
+  WarningHandler warn_;
+  std::unordered_set<std::string> warned_;
+
+  std::vector<Attachment> attachments_;
+  std::vector<std::size_t> pinIndex_;  ///< Core pin index of each attachment.
+  const btRigidBody* referenceBody_ = nullptr;
+
+  std::vector<Tracked> tracked_;
+  std::unordered_map<const btCollisionObject*, std::size_t> trackedIndex_;
+  std::unordered_set<const btCollisionObject*> worldObjects_;  ///< Scratch: pointers in the world.
+
+  std::vector<Collider> colliders_;
+  std::vector<const btCollisionObject*> activeObjects_;
+  struct PlacedSpecial {
+    const btCollisionShape* shape;
+    btTransform world;
+  };
+  std::vector<PlacedSpecial> convexParts_;
+  std::vector<PlacedSpecial> concaveParts_;
+  Points stepStartPositions_;
+  std::vector<btVector3> triangleScratch_;
+
+  bool teleported_ = false;
+  std::uint64_t stepCount_ = 0;
+  double lastStepMicroseconds_ = 0.0;
+  double accumulatedMicroseconds_ = 0.0;
+  btVector3 debugColor_{btScalar(0.9), btScalar(0.2), btScalar(0.2)};
+};
+
+}  // namespace cape::bullet

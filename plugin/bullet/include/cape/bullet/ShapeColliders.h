@@ -1,0 +1,60 @@
+// Bullet collision shapes as cape colliders. Shapes the core knows analytically (sphere, box, capsule,
+// cylinder, the spheres of a btMultiSphereShape, a static plane; compounds of these, nested) become
+// cape::Collider values swept by the core; any other convex shape is handled by Bullet's own GJK/EPA signed
+// distance, and triangle meshes (btBvhTriangleMeshShape, btScaledBvhTriangleMeshShape, heightfields) by
+// particle-triangle contacts, both in a pass after the core's step.
+#pragma once
+
+#include "cape/core/Collider.h"
+
+#include <BulletCollision/CollisionShapes/btCollisionShape.h>
+#include <BulletCollision/CollisionShapes/btConvexShape.h>
+#include <LinearMath/btTransform.h>
+
+#include <string>
+#include <vector>
+
+namespace cape::bullet {
+
+/// What one Bullet shape becomes. Every part carries its transform in the shape's (the object's) frame, so
+/// that its world pose is objectWorldTransform * local.
+struct ShapeConversion {
+  struct Primitive {
+    Collider collider;  ///< Sizes filled in; poses are set every step.
+    btTransform local;
+  };
+  struct Special {
+    const btCollisionShape* shape;  ///< btConvexShape (GJK) or btConcaveShape (triangles).
+    btTransform local;
+  };
+  std::vector<Primitive> primitives;  ///< Swept by the core.
+  std::vector<Special> convex;        ///< Through btGjkEpaSolver2::SignedDistance after the core step.
+  std::vector<Special> concave;       ///< Particle-triangle contacts after the core step.
+  std::vector<std::string> unsupported;  ///< Names (btCollisionShape::getName) of shapes left out.
+  bool empty() const { return primitives.empty() && convex.empty() && concave.empty(); }
+};
+
+/// Converts a shape (with local scaling and collision margins: the sizes describe the surface Bullet's own
+/// collision detection uses) into colliders. `local` places the shape in the object frame (compounds pass
+/// their child transforms down). btEmptyShape gives nothing and is not reported as unsupported.
+///
+/// Scaling: btSphereShape, btBoxShape, btCapsuleShape and btCylinderShape report their scaled sizes; a
+/// btMultiSphereShape's sphere centres are scaled per axis and its radii by the largest scale component
+/// (exact for uniform scaling); a btStaticPlaneShape's scaling is ignored (a plane has no size).
+/// A btMultiSphereShape is the convex hull of its spheres: its spheres are core colliders and the shape
+/// also goes to the GJK pass, which keeps particles out of the hull between the spheres.
+ShapeConversion convertShape(const btCollisionShape* shape, const btTransform& local = btTransform::getIdentity());
+
+/// Signed distance from a world point to a convex shape's true surface (margin included), m, negative
+/// inside, and the outward unit normal at the nearest surface point. Uses Bullet's GJK (outside and within
+/// the margin) and EPA (deeper inside). Returns false when GJK/EPA fails (the outputs are then unchanged).
+bool convexSignedDistance(const btConvexShape* shape, const btTransform& world, const btVector3& point,
+                          btScalar& distance, btVector3& normal);
+
+/// Signed distance from a world point to any shape this adapter understands, m (the minimum over a
+/// compound's children; triangle meshes give the unsigned distance to the nearest triangle minus the shape
+/// margin). For metrics and tests: the "true Bullet surface" of SCENARIOS.md's penetration metric.
+/// Returns +infinity for shapes it cannot measure.
+btScalar shapeSignedDistance(const btCollisionShape* shape, const btTransform& world, const btVector3& point);
+
+}  // namespace cape::bullet

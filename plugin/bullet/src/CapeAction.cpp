@@ -1,0 +1,539 @@
+// CapeAction: the cape's side of each internal step of a Bullet world. Order of one update:
+//   1. prepare (reads the world): drop bodies that left the world, discover colliders, advance every
+//      followed body's pose by one internal step, teleport and inertia, pin targets, core colliders;
+//   2. advance (this cape only): Cape::step, then the post-pass for GJK convex shapes and triangle meshes.
+#include "cape/bullet/CapeAction.h"
+
+#include "cape/bullet/Convert.h"
+
+#include <BulletCollision/CollisionDispatch/btCollisionWorld.h>
+#include <BulletCollision/CollisionShapes/btConcaveShape.h>
+#include <BulletCollision/CollisionShapes/btTriangleCallback.h>
+#include <LinearMath/btAabbUtil2.h>
+#include <LinearMath/btIDebugDraw.h>
+#include <LinearMath/btTransformUtil.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <limits>
+
+namespace cape::bullet {
+
+namespace {
+
+bool sameTransform(const btTransform& a, const btTransform& b) {
+  return a.getOrigin() == b.getOrigin() && a.getBasis()[0] == b.getBasis()[0] && a.getBasis()[1] == b.getBasis()[1] &&
+         a.getBasis()[2] == b.getBasis()[2];
+}
+
+/// Angle of the rotation taking a's basis to b's, rad.
+btScalar rotationAngle(const btTransform& a, const btTransform& b) {
+  const btQuaternion d = b.getRotation() * a.getRotation().inverse();
+  return d.getAngleShortestPath();
+}
+
+/// Pose a fraction s of the way from a to b: origins linearly, rotations along the shortest arc.
+btTransform interpolate(const btTransform& a, const btTransform& b, btScalar s) {
+  if (s >= btScalar(1)) return b;
+  if (s <= btScalar(0)) return a;
+  btQuaternion qa = a.getRotation(), qb = b.getRotation();
+  if (qa.dot(qb) < 0) qb = -qb;
+  return btTransform(qa.slerp(qb, s), a.getOrigin().lerp(b.getOrigin(), s));
+}
+
+/// Collects the triangles Bullet reports over a box (local frame of the shape).
+struct TriangleCollector : btTriangleCallback {
+  std::vector<btVector3>* out;
+  explicit TriangleCollector(std::vector<btVector3>* o) : out(o) {}
+  void processTriangle(btVector3* t, int, int) override {
+    out->push_back(t[0]);
+    out->push_back(t[1]);
+    out->push_back(t[2]);
+  }
+};
+
+/// Closest point of triangle abc to p (Ericson 2005, 5.1.5), and whether it lies inside the face.
+btVector3 closestOnTriangle(const btVector3& p, const btVector3& a, const btVector3& b, const btVector3& c,
+                            bool& onFace) {
+  onFace = false;
+  const btVector3 ab = b - a, ac = c - a, ap = p - a;
+  const btScalar d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const btVector3 bp = p - b;
+  const btScalar d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const btScalar vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const btVector3 cp = p - c;
+  const btScalar d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const btScalar vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const btScalar va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  onFace = true;
+  const btScalar denom = btScalar(1) / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+}  // namespace
+
+CapeAction::CapeAction(FabricPtr fabric, const CapeSettings& settings, const btTransform& placement,
+                       const CapeActionSettings& actionSettings)
+    : cape_(std::move(fabric), settings, toPose(placement)), settings_(actionSettings) {
+  warn_ = [](const std::string& message) { std::cerr << "cape::bullet: " << message << '\n'; };
+}
+
+CapeAction::~CapeAction() = default;
+
+void CapeAction::warnOnce(const std::string& key, const std::string& message) {
+  if (!warned_.insert(key).second) return;
+  if (warn_) warn_(message);
+}
+
+btVector3 CapeAction::position(std::uint32_t particle) const {
+  if (particle >= particleCount()) return btVector3(0, 0, 0);
+  return toBt(Vec3(positions().row(particle).transpose()));
+}
+
+double CapeAction::takeAccumulatedMicroseconds() {
+  const double t = accumulatedMicroseconds_;
+  accumulatedMicroseconds_ = 0.0;
+  return t;
+}
+
+// --- Tracking -----------------------------------------------------------------------------------------
+
+CapeAction::Tracked* CapeAction::find(const btCollisionObject* object) {
+  auto it = trackedIndex_.find(object);
+  return it == trackedIndex_.end() ? nullptr : &tracked_[it->second];
+}
+
+CapeAction::Tracked& CapeAction::track(const btCollisionObject* object) {
+  if (Tracked* t = find(object)) return *t;
+  // First sight: the body is where it is now, and has not moved (no sweep from the origin).
+  Tracked t;
+  t.object = object;
+  const btTransform& w = object->getWorldTransform();
+  t.lastSeen = t.segmentStart = t.segmentEnd = t.stepStart = t.stepEnd = w;
+  trackedIndex_[object] = tracked_.size();
+  tracked_.push_back(std::move(t));
+  return tracked_.back();
+}
+
+void CapeAction::refreshPinIndices() {
+  pinIndex_.assign(attachments_.size(), static_cast<std::size_t>(-1));
+  const std::vector<Pin>& pins = cape_.state().pins;
+  for (std::size_t a = 0; a < attachments_.size(); ++a)
+    for (std::size_t k = 0; k < pins.size(); ++k)
+      if (pins[k].particle == attachments_[a].particle) pinIndex_[a] = k;
+}
+
+// --- Attachments --------------------------------------------------------------------------------------
+
+bool CapeAction::attach(std::uint32_t particle, const btRigidBody* body, const btVector3& localPivot) {
+  if (!ok() || body == nullptr || particle >= particleCount()) return false;
+  const btVector3 target = body->getWorldTransform() * localPivot;
+  if (!std::isfinite(target.x()) || !std::isfinite(target.y()) || !std::isfinite(target.z())) return false;
+  auto it = std::find_if(attachments_.begin(), attachments_.end(),
+                         [&](const Attachment& a) { return a.particle == particle; });
+  if (it != attachments_.end()) {
+    it->body = body;
+    it->localPivot = localPivot;
+  } else {
+    attachments_.push_back({particle, body, localPivot});
+  }
+  track(body);
+  // Pin at the body's pose as this action last saw it, so that the next step sweeps the pin along with it.
+  cape_.pin(particle, toVec3(find(body)->stepEnd * localPivot));
+  refreshPinIndices();
+  return true;
+}
+
+bool CapeAction::attach(std::uint32_t particle, const btRigidBody* body) {
+  if (!ok() || body == nullptr || particle >= particleCount()) return false;
+  return attach(particle, body, body->getWorldTransform().invXform(position(particle)));
+}
+
+std::uint32_t CapeAction::attachNearest(const btRigidBody* body, const btVector3& worldPoint) {
+  if (!ok() || body == nullptr) return kNoParticle;
+  const Vec3 p = toVec3(worldPoint);
+  Eigen::Index best = 0;
+  (positions().rowwise() - p.transpose()).rowwise().squaredNorm().minCoeff(&best);
+  const auto particle = static_cast<std::uint32_t>(best);
+  return attach(particle, body, body->getWorldTransform().invXform(worldPoint)) ? particle : kNoParticle;
+}
+
+std::size_t CapeAction::attachRow(int row, const btRigidBody* body) {
+  if (!ok()) return 0;
+  const int columns = cape_.fabric().gridColumns(), rows = cape_.fabric().gridRows();
+  if (columns <= 0 || row < 0 || row >= rows) return 0;
+  std::size_t n = 0;
+  for (int c = 0; c < columns; ++c) n += attach(static_cast<std::uint32_t>(row * columns + c), body) ? 1 : 0;
+  return n;
+}
+
+void CapeAction::detach(std::uint32_t particle) {
+  auto it = std::find_if(attachments_.begin(), attachments_.end(),
+                         [&](const Attachment& a) { return a.particle == particle; });
+  if (it == attachments_.end()) return;
+  attachments_.erase(it);
+  cape_.unpin(particle);
+  refreshPinIndices();
+}
+
+void CapeAction::detach(const btCollisionObject* body) {
+  std::vector<std::uint32_t> released;
+  for (const Attachment& a : attachments_)
+    if (a.body == body) released.push_back(a.particle);
+  for (std::uint32_t p : released) detach(p);
+  if (referenceBody_ == body) referenceBody_ = nullptr;
+}
+
+void CapeAction::detachAll() {
+  for (const Attachment& a : attachments_) cape_.unpin(a.particle);
+  attachments_.clear();
+  pinIndex_.clear();
+}
+
+const btRigidBody* CapeAction::referenceBody() const {
+  if (referenceBody_ != nullptr) return referenceBody_;
+  return attachments_.empty() ? nullptr : attachments_.front().body;
+}
+
+void CapeAction::addCollider(const btCollisionObject* object) {
+  if (object != nullptr) track(object).explicitCollider = true;
+}
+
+void CapeAction::removeCollider(const btCollisionObject* object) {
+  if (Tracked* t = find(object)) t->explicitCollider = false;
+}
+
+// --- One step -----------------------------------------------------------------------------------------
+
+void CapeAction::updateAction(btCollisionWorld* world, btScalar dt) {
+  prepare(world, dt);
+  advance(dt);
+}
+
+void CapeAction::dropMissing(btCollisionWorld* world) {
+  // Pointers only: a body removed from the world may already be deleted.
+  worldObjects_.clear();
+  const btCollisionObjectArray& objects = world->getCollisionObjectArray();
+  for (int i = 0; i < objects.size(); ++i) worldObjects_.insert(objects[i]);
+  bool dropped = false;
+  for (const Tracked& t : tracked_) {
+    if (worldObjects_.count(t.object) != 0) continue;
+    dropped = true;
+    std::size_t released = 0;
+    for (const Attachment& a : attachments_) released += a.body == t.object ? 1 : 0;
+    if (released > 0) {
+      warnOnce("removed:" + std::to_string(reinterpret_cast<std::uintptr_t>(t.object)) + ":" +
+                   std::to_string(stepCount_),
+               "a body was removed from the world while " + std::to_string(released) +
+                   " cape particle(s) were attached to it; they were released (call detach(body) first)");
+    }
+    detach(t.object);
+  }
+  if (!dropped) return;
+  std::vector<Tracked> kept;
+  kept.reserve(tracked_.size());
+  for (Tracked& t : tracked_)
+    if (worldObjects_.count(t.object) != 0) kept.push_back(std::move(t));
+  tracked_ = std::move(kept);
+  trackedIndex_.clear();
+  for (std::size_t i = 0; i < tracked_.size(); ++i) trackedIndex_[tracked_[i].object] = i;
+}
+
+void CapeAction::discover(btCollisionWorld* world) {
+  for (Tracked& t : tracked_) t.discovered = false;
+  if (!settings_.discoverColliders) return;
+  // The cape's bounds at the start of the step, grown by its thickness and the discovery margin.
+  const Points& x = positions();
+  const btScalar grow = btScalar(cape_.settings().collisionThickness) + settings_.discoveryMargin;
+  const btVector3 lo = toBt(Vec3(x.colwise().minCoeff().transpose())) - btVector3(grow, grow, grow);
+  const btVector3 hi = toBt(Vec3(x.colwise().maxCoeff().transpose())) + btVector3(grow, grow, grow);
+  const btCollisionObjectArray& objects = world->getCollisionObjectArray();
+  for (int i = 0; i < objects.size(); ++i) {
+    const btCollisionObject* o = objects[i];
+    const btBroadphaseProxy* proxy = o->getBroadphaseHandle();
+    if (proxy == nullptr || !o->hasContactResponse()) continue;
+    if (o->getInternalType() == btCollisionObject::CO_SOFT_BODY) continue;
+    const bool accepted = (proxy->m_collisionFilterGroup & settings_.collisionMask) != 0 &&
+                          (settings_.collisionGroup & proxy->m_collisionFilterMask) != 0;
+    if (!accepted || !TestAabbAgainstAabb2(lo, hi, proxy->m_aabbMin, proxy->m_aabbMax)) continue;
+    track(o).discovered = true;
+  }
+}
+
+void CapeAction::advancePoses(btScalar dt) {
+  for (Tracked& t : tracked_) {
+    const btTransform& w = t.object->getWorldTransform();
+    t.jumped = false;
+    if (!sameTransform(w, t.lastSeen)) {
+      // A new pose: Bullet moves kinematic bodies once per stepSimulation (saveKinematicState), so the motion
+      // may be meant to cover several internal steps. Its duration is the displacement over the velocity
+      // Bullet derived for it (a dynamic body moves by v dt each step, so this gives one step); a body moved
+      // without velocity jumps at once.
+      t.segmentStart = t.stepEnd;
+      t.segmentEnd = w;
+      t.lastSeen = w;
+      t.segmentElapsed = 0;
+      t.segmentDuration = 0;
+      const btScalar distance = (t.segmentEnd.getOrigin() - t.segmentStart.getOrigin()).length();
+      const btScalar angle = rotationAngle(t.segmentStart, t.segmentEnd);
+      if (const btRigidBody* body = btRigidBody::upcast(t.object)) {
+        const btScalar v = body->getLinearVelocity().length(), omega = body->getAngularVelocity().length();
+        if (distance > btScalar(1e-6) && v > btScalar(1e-9))
+          t.segmentDuration = distance / v;
+        else if (angle > btScalar(1e-6) && omega > btScalar(1e-9))
+          t.segmentDuration = angle / omega;
+        if (!std::isfinite(t.segmentDuration)) t.segmentDuration = 0;
+      }
+      if (distance > settings_.teleportDistance || angle > settings_.teleportAngle) {
+        t.jumped = true;
+        t.segmentDuration = 0;
+      }
+    }
+    t.stepStart = t.stepEnd;
+    t.segmentElapsed += dt;
+    // Within a quarter step of the end counts as the end: rounding must not leave a sliver behind.
+    const btScalar s = t.segmentDuration > 0 && t.segmentElapsed < t.segmentDuration - btScalar(0.25) * dt
+                           ? t.segmentElapsed / t.segmentDuration
+                           : btScalar(1);
+    t.stepEnd = interpolate(t.segmentStart, t.segmentEnd, s);
+    if (t.jumped) t.stepStart = t.stepEnd;
+  }
+}
+
+void CapeAction::applyTeleport() {
+  teleported_ = false;
+  const btRigidBody* ref = referenceBody();
+  Tracked* t = ref != nullptr ? find(ref) : nullptr;
+  if (t == nullptr) return;
+  if (t->jumped) {
+    // The character jumped: carry the cape rigidly (positions, velocities, pin targets), no stretching.
+    // The jump is measured from where the action had the body to where it is now.
+    const btTransform delta = t->segmentEnd * t->segmentStart.inverse();
+    cape_.teleport(toPose(delta));
+    teleported_ = true;
+  }
+}
+
+void CapeAction::applyInertia() {
+  const btRigidBody* ref = referenceBody();
+  Tracked* t = ref != nullptr ? find(ref) : nullptr;
+  if (t == nullptr || t->jumped) return;
+  const btScalar li = btClamped(settings_.linearInertia, btScalar(0), btScalar(1));
+  const btScalar ai = btClamped(settings_.angularInertia, btScalar(0), btScalar(1));
+  if (li >= btScalar(1) && ai >= btScalar(1)) return;
+  // Shift the free particles by the part of the body's motion they should not feel: its rotation about its
+  // origin by (1 - angular inertia) of the step's angle, and (1 - linear inertia) of its displacement.
+  const btVector3 c0 = t->stepStart.getOrigin(), c1 = t->stepEnd.getOrigin();
+  btQuaternion dq = t->stepEnd.getRotation() * t->stepStart.getRotation().inverse();
+  if (dq.w() < 0) dq = -dq;
+  const btQuaternion partial = btQuaternion::getIdentity().slerp(dq, btScalar(1) - ai);
+  const Quat r(static_cast<float>(partial.w()), static_cast<float>(partial.x()), static_cast<float>(partial.y()),
+               static_cast<float>(partial.z()));
+  const Eigen::Matrix3f m = r.normalized().toRotationMatrix();
+  const Vec3 centre = toVec3(c0);
+  const Vec3 shift = toVec3((btScalar(1) - li) * (c1 - c0));
+  // Every particle, and where every pin starts this step, moves alike: otherwise the pins would sweep from
+  // their old place while the free particles already stand in the new one, and the springs between them
+  // would turn the difference into motion.
+  CapeState& s = cape_.mutableState();
+  for (Eigen::Index i = 0; i < s.positions.rows(); ++i) {
+    const Vec3 x = s.positions.row(i).transpose();
+    s.positions.row(i) = (m * (x - centre) + centre + shift).transpose();
+    s.velocities.row(i) = (m * Vec3(s.velocities.row(i).transpose())).transpose();
+  }
+  for (Pin& p : s.pins) p.previousTarget = m * (p.previousTarget - centre) + centre + shift;
+}
+
+void CapeAction::updatePins() {
+  for (std::size_t a = 0; a < attachments_.size(); ++a) {
+    const Attachment& att = attachments_[a];
+    const Tracked* t = find(att.body);
+    if (t == nullptr) continue;
+    const Vec3 target = toVec3(t->stepEnd * att.localPivot);
+    if (t->jumped || pinIndex_[a] == static_cast<std::size_t>(-1)) {
+      cape_.pin(att.particle, target);  // retargets without a sweep
+    } else {
+      cape_.movePin(pinIndex_[a], target);
+    }
+  }
+  refreshPinIndices();
+}
+
+void CapeAction::buildColliders() {
+  colliders_.clear();
+  activeObjects_.clear();
+  convexParts_.clear();
+  concaveParts_.clear();
+  for (Tracked& t : tracked_) {
+    if (!t.explicitCollider && !t.discovered) continue;
+    if (!t.converted) {
+      t.shape = convertShape(t.object->getCollisionShape());
+      t.converted = true;
+      for (const std::string& name : t.shape.unsupported)
+        warnOnce("shape:" + name, "unsupported collision shape '" + name + "' ignored by the cape");
+    }
+    if (t.shape.empty()) continue;
+    activeObjects_.push_back(t.object);
+    for (const ShapeConversion::Primitive& p : t.shape.primitives) {
+      Collider c = p.collider;
+      c.previous = toPose(t.stepStart * p.local);
+      c.current = toPose(t.stepEnd * p.local);
+      if (c.shape == ColliderShape::Plane) {
+        // Planes are static half-spaces: the core reads their normal and constant in the collider frame.
+        c.previous = c.current;
+      }
+      colliders_.push_back(std::move(c));
+    }
+    for (const ShapeConversion::Special& s : t.shape.convex) convexParts_.push_back({s.shape, t.stepEnd * s.local});
+    for (const ShapeConversion::Special& s : t.shape.concave) concaveParts_.push_back({s.shape, t.stepEnd * s.local});
+  }
+}
+
+void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
+  if (!ok() || world == nullptr || !(dt > 0)) return;
+  dropMissing(world);
+  discover(world);
+  advancePoses(dt);
+  applyTeleport();
+  updatePins();
+  applyInertia();  // after the pins have their new targets: it shifts where they start
+  buildColliders();
+}
+
+void CapeAction::advance(btScalar dt) {
+  if (!ok() || !(dt > 0)) return;
+  const auto start = std::chrono::steady_clock::now();
+  const bool post = !convexParts_.empty() || !concaveParts_.empty();
+  if (post) stepStartPositions_ = positions();
+  cape_.step(static_cast<float>(dt), ColliderSpan(colliders_));
+  if (!convexParts_.empty()) convexPass(dt);
+  if (!concaveParts_.empty()) concavePass(dt);
+  ++stepCount_;
+  lastStepMicroseconds_ = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  accumulatedMicroseconds_ += lastStepMicroseconds_;
+}
+
+void CapeAction::respond(Eigen::Index i, const Vec3& normal, float pushDistance, btScalar dt) {
+  // An inelastic contact: the velocity into the surface goes; Coulomb friction takes from the tangential
+  // velocity at most mu times the normal velocity change (the push over the step, plus the velocity removed).
+  CapeState& s = cape_.mutableState();
+  Vec3 v = s.velocities.row(i).transpose();
+  const float vn = v.dot(normal);
+  float dvn = pushDistance / static_cast<float>(dt);
+  if (vn < 0.0f) {
+    v -= vn * normal;
+    dvn -= vn;
+  }
+  const Vec3 vt = v - v.dot(normal) * normal;
+  const float vtLen = vt.norm();
+  if (vtLen > 0.0f) v -= vt * (std::min(vtLen, cape_.settings().friction * dvn) / vtLen);
+  s.velocities.row(i) = v.transpose();
+}
+
+void CapeAction::convexPass(btScalar dt) {
+  // After the core step: every free particle closer to a convex shape's true surface than the cape's
+  // thickness goes out along the GJK/EPA normal, and loses the velocity that points into the shape.
+  CapeState& s = cape_.mutableState();
+  const btScalar thickness = btScalar(cape_.settings().collisionThickness);
+  for (const PlacedSpecial& part : convexParts_) {
+    const auto* shape = static_cast<const btConvexShape*>(part.shape);
+    btVector3 lo, hi;
+    shape->getAabb(part.world, lo, hi);
+    const btVector3 grow(thickness, thickness, thickness);
+    lo -= grow;
+    hi += grow;
+    for (Eigen::Index i = 0; i < s.positions.rows(); ++i) {
+      if (s.inverseMasses[i] == 0.0f) continue;
+      const btVector3 p = toBt(Vec3(s.positions.row(i).transpose()));
+      if (!TestPointAgainstAabb2(lo, hi, p)) continue;
+      btScalar d = 0;
+      btVector3 n;
+      if (!convexSignedDistance(shape, part.world, p, d, n) || d >= thickness) continue;
+      s.positions.row(i) = toVec3(p + n * (thickness - d)).transpose();
+      respond(i, toVec3(n), static_cast<float>(thickness - d), dt);
+    }
+  }
+}
+
+void CapeAction::concavePass(btScalar dt) {
+  // After the core step: particle against triangle. Each particle keeps the side of every nearby triangle it
+  // was on at the start of the step (so a particle that crossed a thin face this step comes back), at least
+  // the thickness (plus the shape's margin, the skin Bullet's own contacts keep) away from it.
+  CapeState& s = cape_.mutableState();
+  for (const PlacedSpecial& part : concaveParts_) {
+    const auto* shape = static_cast<const btConcaveShape*>(part.shape);
+    const btScalar keep = btScalar(cape_.settings().collisionThickness) + shape->getMargin();
+    btVector3 lo, hi;
+    shape->getAabb(part.world, lo, hi);
+    const btVector3 grow(keep, keep, keep);
+    const btMatrix3x3& basis = part.world.getBasis();
+    for (Eigen::Index i = 0; i < s.positions.rows(); ++i) {
+      if (s.inverseMasses[i] == 0.0f) continue;
+      const btVector3 pw = toBt(Vec3(s.positions.row(i).transpose()));
+      const btVector3 p0w = toBt(Vec3(stepStartPositions_.row(i).transpose()));
+      btVector3 boxLo = pw, boxHi = pw;
+      boxLo.setMin(p0w);
+      boxHi.setMax(p0w);
+      if (!TestAabbAgainstAabb2(boxLo - grow, boxHi + grow, lo, hi)) continue;
+      btVector3 p = part.world.invXform(pw);
+      const btVector3 p0 = part.world.invXform(p0w);
+      btVector3 qlo = p, qhi = p;
+      qlo.setMin(p0);
+      qhi.setMax(p0);
+      triangleScratch_.clear();
+      TriangleCollector collect(&triangleScratch_);
+      shape->processAllTriangles(&collect, qlo - grow, qhi + grow);
+      if (triangleScratch_.empty()) continue;
+      btVector3 pushed(0, 0, 0);
+      for (std::size_t k = 0; k + 2 < triangleScratch_.size(); k += 3) {
+        const btVector3 &a = triangleScratch_[k], &b = triangleScratch_[k + 1], &c = triangleScratch_[k + 2];
+        btVector3 n = (b - a).cross(c - a);
+        const btScalar len = n.length();
+        if (!(len > btScalar(1e-12))) continue;
+        n /= len;
+        const btScalar side0 = n.dot(p0 - a);
+        const btScalar side = side0 < 0 ? btScalar(-1) : btScalar(1);
+        bool onFace = false;
+        const btVector3 q = closestOnTriangle(p, a, b, c, onFace);
+        if (onFace) {
+          const btScalar d = side * n.dot(p - a);
+          if (d < keep) {
+            p += (side * n) * (keep - d);
+            pushed = side * n;
+          }
+        } else {
+          const btVector3 e = p - q;
+          const btScalar d = e.length();
+          if (d < keep && d > btScalar(1e-9)) {
+            p += e * ((keep - d) / d);
+            pushed = e / d;
+          }
+        }
+      }
+      if (pushed.isZero()) continue;
+      s.positions.row(i) = toVec3(part.world * p).transpose();
+      respond(i, toVec3(basis * pushed), static_cast<float>((part.world * p - pw).length()), dt);
+    }
+  }
+}
+
+void CapeAction::debugDraw(btIDebugDraw* drawer) {
+  if (drawer == nullptr || !ok()) return;
+  const std::vector<std::uint32_t>& tri = cape_.fabric().triangles();
+  for (std::size_t k = 0; k + 2 < tri.size(); k += 3) {
+    const btVector3 a = position(tri[k]), b = position(tri[k + 1]), c = position(tri[k + 2]);
+    drawer->drawLine(a, b, debugColor_);
+    drawer->drawLine(b, c, debugColor_);
+    drawer->drawLine(c, a, debugColor_);
+  }
+}
+
+}  // namespace cape::bullet

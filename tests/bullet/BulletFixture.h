@@ -1,0 +1,106 @@
+// Shared set-up for the adapter's tests: a real Bullet world (discrete, or soft-rigid for the twin), bodies
+// made the usual way, and the canonical cape.
+#pragma once
+
+#include "cape/bullet/CapeAction.h"
+#include "cape/core/Scene.h"
+
+#include <btBulletDynamicsCommon.h>
+#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+
+#include <memory>
+#include <vector>
+
+namespace capetest {
+
+constexpr btScalar kFrame = btScalar(1.0 / 60.0);
+constexpr btScalar kFixed = btScalar(1.0 / 240.0);
+constexpr btScalar kSeedStep = btScalar(0.00875);
+
+/// A Bullet world and the bodies the test made (removed and deleted in order at the end).
+struct World {
+  explicit World(bool soft = false) {
+    if (soft)
+      config = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();
+    else
+      config = std::make_unique<btDefaultCollisionConfiguration>();
+    dispatcher = std::make_unique<btCollisionDispatcher>(config.get());
+    broadphase = std::make_unique<btDbvtBroadphase>();
+    solver = std::make_unique<btSequentialImpulseConstraintSolver>();
+    if (soft) {
+      auto* w = new btSoftRigidDynamicsWorld(dispatcher.get(), broadphase.get(), solver.get(), config.get());
+      w->getWorldInfo().m_gravity = btVector3(0, btScalar(-9.8), 0);
+      w->getWorldInfo().m_sparsesdf.Initialize();
+      w->getWorldInfo().m_broadphase = broadphase.get();
+      w->getWorldInfo().m_dispatcher = dispatcher.get();
+      world.reset(w);
+    } else {
+      world = std::make_unique<btDiscreteDynamicsWorld>(dispatcher.get(), broadphase.get(), solver.get(), config.get());
+    }
+    world->setGravity(btVector3(0, btScalar(-9.8), 0));
+  }
+  ~World() {
+    for (int i = world->getNumCollisionObjects() - 1; i >= 0; --i) {
+      btCollisionObject* o = world->getCollisionObjectArray()[i];
+      if (btRigidBody* b = btRigidBody::upcast(o)) world->removeRigidBody(b); else world->removeCollisionObject(o);
+    }
+  }
+  btSoftRigidDynamicsWorld* soft() { return static_cast<btSoftRigidDynamicsWorld*>(world.get()); }
+
+  /// A static body (mass 0) with the shape at the transform; group/mask < 0: Bullet's defaults.
+  btRigidBody* addStatic(btCollisionShape* shape, const btTransform& t, int group = -1, int mask = -1) {
+    shapes.emplace_back(shape);
+    auto state = std::make_unique<btDefaultMotionState>(t);
+    btRigidBody::btRigidBodyConstructionInfo info(0, state.get(), shape);
+    auto body = std::make_unique<btRigidBody>(info);
+    if (group >= 0)
+      world->addRigidBody(body.get(), group, mask);
+    else
+      world->addRigidBody(body.get());
+    states.push_back(std::move(state));
+    bodies.push_back(std::move(body));
+    return bodies.back().get();
+  }
+  /// A kinematic body (moved through its motion state, once per stepSimulation).
+  btRigidBody* addKinematic(btCollisionShape* shape, const btTransform& t) {
+    btRigidBody* b = addStatic(shape, t);
+    b->setCollisionFlags(b->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+    b->setActivationState(DISABLE_DEACTIVATION);
+    return b;
+  }
+  static void moveKinematic(btRigidBody* b, const btTransform& t) { b->getMotionState()->setWorldTransform(t); }
+
+  std::unique_ptr<btCollisionConfiguration> config;
+  std::unique_ptr<btCollisionDispatcher> dispatcher;
+  std::unique_ptr<btBroadphaseInterface> broadphase;
+  std::unique_ptr<btSequentialImpulseConstraintSolver> solver;
+  std::unique_ptr<btDiscreteDynamicsWorld> world;
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  std::vector<std::unique_ptr<btMotionState>> states;
+  std::vector<std::unique_ptr<btRigidBody>> bodies;
+};
+
+/// The canonical 20 x 20 cape (0.6 m x 1.0 m, 0.4 kg), tethered to its top corners.
+inline cape::FabricPtr cornerFabric(int n = 20) { return cape::makeCapeRig(n, cape::Attachment::Corners).fabric; }
+
+/// Lying flat and horizontal (rotated +90 degrees about X: the grid spans x in [-0.3, 0.3], z in [-0.5, 0.5]), centred on (0, y, 0).
+inline btTransform horizontalAt(btScalar y) {
+  btTransform t(btQuaternion(btVector3(1, 0, 0), SIMD_HALF_PI), btVector3(btScalar(-0.3), y, btScalar(0.5)));
+  return t;
+}
+
+inline bool allFinite(const cape::Points& x) { return x.allFinite(); }
+
+/// Largest structural strain (|xi - xj| - L0) / L0 of the cape.
+inline float maxStructuralStrain(const cape::Cape& c) {
+  const cape::SpringSet& s = c.fabric().springs(cape::SpringFamily::Structural);
+  float worst = 0.0f;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const float len = (c.state().positions.row(s.first[k]) - c.state().positions.row(s.second[k])).norm();
+    worst = std::max(worst, std::abs(len - s.restLength[k]) / s.restLength[k]);
+  }
+  return worst;
+}
+
+}  // namespace capetest

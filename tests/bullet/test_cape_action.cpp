@@ -1,0 +1,404 @@
+// CapeAction in real Bullet worlds: pins follow kinematic bodies at every internal step, colliders come from
+// Bullet shapes (found by discovery, filtered by group and mask), both reference steppings work.
+#include "BulletFixture.h"
+
+#include "cape/bullet/Convert.h"
+
+#include <BulletCollision/CollisionShapes/btTriangleMesh.h>
+#include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+using namespace capetest;
+using cape::bullet::CapeAction;
+
+namespace {
+
+/// The attachment body's pose at time t: constant linear velocity and constant rotation rate about an
+/// oblique axis (so lerp/slerp between two frame poses is the exact pose in between).
+btTransform movingPose(double t) {
+  const btVector3 axis = btVector3(btScalar(0.3), 1, btScalar(0.2)).normalized();
+  return btTransform(btQuaternion(axis, btScalar(1.5 * t)),
+                     btVector3(btScalar(0.8 * t), btScalar(1.5 + 0.2 * t), btScalar(-0.5 * t)));
+}
+
+struct PinProbe {
+  CapeAction* action = nullptr;
+  std::vector<std::vector<btVector3>> recorded;  ///< Pinned particle positions after each internal step.
+  static void tick(btDynamicsWorld* world, btScalar) {
+    auto* self = static_cast<PinProbe*>(world->getWorldUserInfo());
+    std::vector<btVector3> row;
+    for (const cape::bullet::Attachment& a : self->action->attachments()) row.push_back(self->action->position(a.particle));
+    self->recorded.push_back(row);
+  }
+};
+
+}  // namespace
+
+class PinStepping : public ::testing::TestWithParam<double> {};
+
+TEST_P(PinStepping, PinsFollowATranslatingRotatingKinematicBodyAtEveryInternalStep) {
+  const btScalar fixed = btScalar(GetParam());
+  World w;
+  btRigidBody* body = w.addKinematic(new btBoxShape(btVector3(btScalar(0.2), btScalar(0.3), btScalar(0.1))), movingPose(0));
+  CapeAction action(cornerFabric(), cape::CapeSettings(), btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f)));
+  ASSERT_TRUE(action.ok());
+  const btVector3 left(btScalar(-0.3), 0, btScalar(0.15)), right(btScalar(0.3), 0, btScalar(0.15));
+  ASSERT_TRUE(action.attach(0, body, left));
+  ASSERT_TRUE(action.attach(19, body, right));
+  w.world->addAction(&action);
+  PinProbe probe;
+  probe.action = &action;
+  w.world->setInternalTickCallback(&PinProbe::tick, &probe);
+
+  double tPrev = 0.0;  // time of the last frame whose pose the world has taken
+  double worst = 0.0;
+  int steps = 0;
+  for (int frame = 1; frame <= 120; ++frame) {
+    const double t = frame / 60.0;
+    World::moveKinematic(body, movingPose(t));
+    probe.recorded.clear();
+    const int n = w.world->stepSimulation(kFrame, 8, fixed);
+    ASSERT_EQ(static_cast<int>(probe.recorded.size()), std::min(n, 8));
+    if (n == 0) continue;
+    // Bullet gives the kinematic body its new pose at the first internal step; the action spreads the
+    // motion over the n internal steps of this call, so after step j the pin sits at the pose (j+1)/n of
+    // the way from the last pose to the new one.
+    for (int j = 0; j < n; ++j) {
+      const btTransform expected = movingPose(tPrev + (t - tPrev) * (j + 1) / n);
+      worst = std::max(worst, double((probe.recorded[j][0] - expected * left).length()));
+      worst = std::max(worst, double((probe.recorded[j][1] - expected * right).length()));
+      ++steps;
+    }
+    tPrev = t;
+  }
+  EXPECT_GT(steps, 100);
+  EXPECT_LT(worst, 1e-5) << "worst pin error over " << steps << " internal steps";
+  EXPECT_TRUE(allFinite(action.positions()));
+  EXPECT_LT(maxStructuralStrain(action.cape()), 0.2f);
+  w.world->removeAction(&action);
+}
+
+INSTANTIATE_TEST_SUITE_P(Steppings, PinStepping, ::testing::Values(1.0 / 240.0, 0.00875));
+
+// --- Dropped on shapes found by discovery ---------------------------------------------------------------
+
+struct DropCase {
+  std::string name;
+  std::function<btCollisionShape*()> make;
+  double fixed;
+};
+
+class DropOnShape : public ::testing::TestWithParam<DropCase> {};
+
+TEST_P(DropOnShape, ComesToRestOnItWithNoParticleDeeperThanOneMillimetre) {
+  const DropCase& c = GetParam();
+  World w;
+  btCollisionShape* shape = c.make();
+  btRigidBody* body = w.addStatic(shape, btTransform::getIdentity());
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.7)));
+  w.world->addAction(&action);
+  double worstDepth = 0.0;
+  for (int frame = 0; frame < 150; ++frame) {
+    w.world->stepSimulation(kFrame, 8, btScalar(c.fixed));
+    for (std::size_t i = 0; i < action.particleCount(); ++i) {
+      const btScalar d = cape::bullet::shapeSignedDistance(shape, body->getWorldTransform(), action.position(std::uint32_t(i)));
+      worstDepth = std::max(worstDepth, double(-d));
+    }
+  }
+  ASSERT_TRUE(allFinite(action.positions()));
+  EXPECT_LT(worstDepth, 1e-3) << c.name;
+  ASSERT_EQ(action.activeObjects().size(), 1u) << c.name;
+  // It rests on the shape: the middle of the cape is on the top of the shape, within a few centimetres.
+  const std::uint32_t middle = 10 * 20 + 10;
+  const btScalar d = cape::bullet::shapeSignedDistance(shape, body->getWorldTransform(), action.position(middle));
+  EXPECT_LT(d, 0.03) << c.name;
+  EXPECT_GT(action.position(middle).y(), 0.0) << c.name;
+  w.world->removeAction(&action);
+}
+
+namespace {
+btCollisionShape* makeCompound() {
+  // Nested: a compound holding a box and a compound (a sphere offset and rotated).
+  auto* inner = new btCompoundShape();
+  inner->addChildShape(btTransform(btQuaternion(btVector3(0, 0, 1), 0.3f), btVector3(0.2f, 0.0f, 0.0f)), new btSphereShape(0.2f));
+  auto* outer = new btCompoundShape();
+  outer->addChildShape(btTransform(btQuaternion::getIdentity(), btVector3(-0.15f, 0.1f, 0.0f)), new btBoxShape(btVector3(0.15f, 0.2f, 0.2f)));
+  outer->addChildShape(btTransform(btQuaternion::getIdentity(), btVector3(0.1f, 0.1f, 0.0f)), inner);
+  return outer;
+}
+btCollisionShape* makeScaledCylinder() {
+  auto* s = new btCylinderShape(btVector3(0.2f, 0.2f, 0.2f));
+  s->setLocalScaling(btVector3(1.5f, 1.0f, 1.5f));  // radius 0.3, half height 0.2
+  return s;
+}
+btCollisionShape* makeHull() {
+  // A hexagonal prism (flat top, 0.3 m across the corners, 0.4 m tall): not a primitive the core knows, so
+  // Bullet's GJK handles it.
+  auto* h = new btConvexHullShape();
+  for (int k = 0; k < 6; ++k) {
+    const float a = float(k) * SIMD_PI / 3.0f;
+    h->addPoint(btVector3(0.3f * std::cos(a), 0.2f, 0.3f * std::sin(a)), false);
+    h->addPoint(btVector3(0.3f * std::cos(a), -0.2f, 0.3f * std::sin(a)), k == 5);
+  }
+  return h;
+}
+}  // namespace
+
+INSTANTIATE_TEST_SUITE_P(
+    Shapes, DropOnShape,
+    ::testing::Values(
+        DropCase{"sphere", [] { return static_cast<btCollisionShape*>(new btSphereShape(0.3f)); }, 1.0 / 240.0},
+        DropCase{"box", [] { return static_cast<btCollisionShape*>(new btBoxShape(btVector3(0.3f, 0.2f, 0.3f))); }, 1.0 / 240.0},
+        DropCase{"capsuleX", [] { return static_cast<btCollisionShape*>(new btCapsuleShapeX(0.15f, 0.6f)); }, 1.0 / 240.0},
+        DropCase{"cylinderZ", [] { return static_cast<btCollisionShape*>(new btCylinderShapeZ(btVector3(0.25f, 0.25f, 0.3f))); }, 1.0 / 240.0},
+        DropCase{"compound", makeCompound, 1.0 / 240.0},
+        DropCase{"scaledCylinder", makeScaledCylinder, 1.0 / 240.0},
+        DropCase{"multiSphere", [] {
+           const btVector3 centres[2] = {btVector3(-0.15f, 0, 0), btVector3(0.15f, 0, 0)};
+           const btScalar radii[2] = {0.2f, 0.25f};
+           return static_cast<btCollisionShape*>(new btMultiSphereShape(centres, radii, 2));
+         }, 1.0 / 240.0},
+        DropCase{"convexHullGjk", makeHull, 1.0 / 240.0},
+        DropCase{"sphereSeedStep", [] { return static_cast<btCollisionShape*>(new btSphereShape(0.3f)); }, 0.00875}),
+    [](const ::testing::TestParamInfo<DropCase>& info) { return info.param.name; });
+
+TEST(CapeAction, ConvexHullGoesThroughGjkAndPrimitivesDoNot) {
+  World w;
+  w.addStatic(makeHull(), btTransform::getIdentity());
+  w.addStatic(new btSphereShape(0.2f), btTransform(btQuaternion::getIdentity(), btVector3(2, 0, 0)));
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.5)));
+  cape::bullet::CapeActionSettings s;
+  s.discoveryMargin = 3.0f;
+  action.setActionSettings(s);
+  w.world->addAction(&action);
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_EQ(action.gjkShapeCount(), 1u);
+  EXPECT_EQ(action.coreColliders().size(), 1u);
+  EXPECT_EQ(action.coreColliders()[0].shape, cape::ColliderShape::Sphere);
+  w.world->removeAction(&action);
+}
+
+TEST(CapeAction, StaticPlaneAndTriangleMeshHoldTheCape) {
+  World w;
+  // A 4 m x 4 m two-triangle ground at y = 0 (a btBvhTriangleMeshShape) and a plane at y = -0.5 below it.
+  auto* mesh = new btTriangleMesh();
+  mesh->addTriangle(btVector3(-2, 0, -2), btVector3(-2, 0, 2), btVector3(2, 0, 2));
+  mesh->addTriangle(btVector3(-2, 0, -2), btVector3(2, 0, 2), btVector3(2, 0, -2));
+  auto* shape = new btBvhTriangleMeshShape(mesh, true);
+  shape->setMargin(0.0f);
+  w.addStatic(shape, btTransform::getIdentity());
+  w.addStatic(new btStaticPlaneShape(btVector3(0, 1, 0), -0.5f), btTransform::getIdentity());
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.3)));
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 90; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_EQ(action.meshShapeCount(), 1u);
+  const float lowest = action.positions().col(1).minCoeff();
+  EXPECT_GT(lowest, -1e-3f) << "fell through the triangle mesh";
+  EXPECT_LT(action.positions().col(1).maxCoeff(), 0.05f) << "should lie on it";
+  w.world->removeAction(&action);
+  delete mesh;
+}
+
+TEST(CapeAction, HeightfieldHoldsTheCape) {
+  World w;
+  static float heights[9 * 9];
+  for (float& h : heights) h = 0.0f;
+  auto* terrain = new btHeightfieldTerrainShape(9, 9, heights, 1.0f, -1.0f, 1.0f, 1, PHY_FLOAT, false);
+  terrain->setLocalScaling(btVector3(0.5f, 1.0f, 0.5f));
+  w.addStatic(terrain, btTransform::getIdentity());
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.3)));
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 90; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_EQ(action.meshShapeCount(), 1u);
+  EXPECT_GT(action.positions().col(1).minCoeff(), -1e-3f - terrain->getMargin());
+  w.world->removeAction(&action);
+}
+
+TEST(CapeAction, BodyExcludedByGroupAndMaskIsIgnored) {
+  World w;
+  const int kNotCape = 64;  // a user group the cape's mask leaves out
+  w.addStatic(new btSphereShape(0.3f), btTransform::getIdentity(), kNotCape, btBroadphaseProxy::AllFilter);
+  cape::bullet::CapeActionSettings s;
+  s.collisionMask = btBroadphaseProxy::AllFilter & ~kNotCape;
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.5)), s);
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 40; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_TRUE(action.activeObjects().empty());
+  EXPECT_LT(action.positions().col(1).maxCoeff(), -0.3f) << "the cape fell through the excluded sphere";
+  w.world->removeAction(&action);
+}
+
+TEST(CapeAction, ExplicitColliderWithoutDiscovery) {
+  World w;
+  btRigidBody* a = w.addStatic(new btSphereShape(0.3f), btTransform::getIdentity());
+  w.addStatic(new btBoxShape(btVector3(1, 0.05f, 1)), btTransform(btQuaternion::getIdentity(), btVector3(0, -0.6f, 0)));
+  cape::bullet::CapeActionSettings s;
+  s.discoverColliders = false;
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.5)), s);
+  action.addCollider(a);
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 60; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  ASSERT_EQ(action.activeObjects().size(), 1u);
+  EXPECT_EQ(action.activeObjects()[0], a);
+  EXPECT_GT(action.position(10 * 20 + 10).y(), 0.25f);
+  w.world->removeAction(&action);
+}
+
+// --- Unsupported shapes, removed bodies -----------------------------------------------------------------
+
+namespace {
+/// A concave shape Bullet does not know: the adapter cannot turn it into anything.
+class OddShape : public btConcaveShape {
+ public:
+  OddShape() { m_shapeType = CUSTOM_CONCAVE_SHAPE_TYPE; }
+  void getAabb(const btTransform& t, btVector3& lo, btVector3& hi) const override {
+    lo = t.getOrigin() - btVector3(1, 1, 1);
+    hi = t.getOrigin() + btVector3(1, 1, 1);
+  }
+  void processAllTriangles(btTriangleCallback*, const btVector3&, const btVector3&) const override {}
+  void setLocalScaling(const btVector3& s) override { scaling_ = s; }
+  const btVector3& getLocalScaling() const override { return scaling_; }
+  void calculateLocalInertia(btScalar, btVector3& inertia) const override { inertia.setZero(); }
+  const char* getName() const override { return "OddShape"; }
+
+ private:
+  btVector3 scaling_{1, 1, 1};
+};
+}  // namespace
+
+TEST(CapeAction, UnsupportedShapeWarnsOnceNamingIt) {
+  World w;
+  w.addStatic(new OddShape(), btTransform::getIdentity());
+  w.addStatic(new OddShape(), btTransform(btQuaternion::getIdentity(), btVector3(0.2f, 0, 0)));
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.5)));
+  std::vector<std::string> warnings;
+  action.setWarningHandler([&](const std::string& m) { warnings.push_back(m); });
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 30; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("OddShape"), std::string::npos);
+  EXPECT_TRUE(allFinite(action.positions()));
+  w.world->removeAction(&action);
+}
+
+TEST(CapeAction, BodyRemovedAndDeletedWhileAttachedIsDroppedAndItsParticlesReleased) {
+  World w;
+  auto shape = std::make_unique<btSphereShape>(0.1f);
+  btDefaultMotionState state(btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+  auto body = std::make_unique<btRigidBody>(btRigidBody::btRigidBodyConstructionInfo(0, &state, shape.get()));
+  body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+  w.world->addRigidBody(body.get());
+  CapeAction action(cornerFabric(), cape::CapeSettings(), btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f)));
+  std::vector<std::string> warnings;
+  action.setWarningHandler([&](const std::string& m) { warnings.push_back(m); });
+  ASSERT_EQ(action.attachRow(0, body.get()), 20u);
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 10; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_EQ(action.cape().state().pins.size(), 20u);
+  // The documented rule: removing a body from the world is enough; the action drops it at its next update
+  // without touching it (so it may already be deleted: ASan checks that).
+  w.world->removeRigidBody(body.get());
+  body.reset();
+  for (int frame = 0; frame < 10; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_TRUE(action.attachments().empty());
+  EXPECT_TRUE(action.cape().state().pins.empty());
+  EXPECT_GT(action.cape().state().inverseMasses.minCoeff(), 0.0f);
+  EXPECT_EQ(warnings.size(), 1u);
+  EXPECT_LT(action.positions().col(1).maxCoeff(), 1.4f) << "released particles fall";
+  w.world->removeAction(&action);
+}
+
+TEST(CapeAction, DetachBeforeDeletingWarnsAboutNothing) {
+  World w;
+  btRigidBody* body = w.addKinematic(new btSphereShape(0.1f), btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+  CapeAction action(cornerFabric(), cape::CapeSettings(), btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f)));
+  int warnings = 0;
+  action.setWarningHandler([&](const std::string&) { ++warnings; });
+  const std::uint32_t p = action.attachNearest(body, btVector3(0.3f, 1.5f, 0.15f));
+  EXPECT_EQ(p, 19u);
+  w.world->addAction(&action);
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_LT((action.position(p) - btVector3(0.3f, 1.5f, 0.15f)).length(), 1e-5f);
+  action.detach(body);
+  w.world->removeRigidBody(body);
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_EQ(warnings, 0);
+  EXPECT_TRUE(action.attachments().empty());
+  w.world->removeAction(&action);
+}
+
+// --- Fast motion ----------------------------------------------------------------------------------------
+
+TEST(CapeAction, TeleportFiftyMetresCarriesTheCapeWithoutStretching) {
+  World w;
+  const btTransform start(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0));
+  btRigidBody* body = w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)), start);
+  CapeAction action(cornerFabric(), cape::CapeSettings(), btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.56f, 0.15f)));
+  action.attach(0, body, btVector3(-0.3f, 0.06f, 0.15f));
+  action.attach(19, body, btVector3(0.3f, 0.06f, 0.15f));
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 60; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  const float strainBefore = maxStructuralStrain(action.cape());
+  // Jump 50 m along X and turn 90 degrees in one frame.
+  const btTransform jumped(btQuaternion(btVector3(0, 1, 0), SIMD_HALF_PI), btVector3(50, 1.5f, 0));
+  World::moveKinematic(body, jumped);
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  float worstStrain = maxStructuralStrain(action.cape());
+  for (int frame = 0; frame < 30; ++frame) {
+    w.world->stepSimulation(kFrame, 8, kFixed);
+    worstStrain = std::max(worstStrain, maxStructuralStrain(action.cape()));
+  }
+  ASSERT_TRUE(allFinite(action.positions()));
+  EXPECT_LT(worstStrain, std::max(0.05f, 2.0f * strainBefore));
+  for (std::size_t i = 0; i < action.particleCount(); ++i)
+    EXPECT_LT((action.position(std::uint32_t(i)) - jumped.getOrigin()).length(), 2.0f);
+  EXPECT_LT((action.position(0) - jumped * btVector3(-0.3f, 0.06f, 0.15f)).length(), 1e-4f);
+}
+
+TEST(CapeAction, ZeroInertiaCarriesTheCapeAlongWithItsBody) {
+  // With no linear inertia the free particles ride with the body: a cape pinned to a body that starts
+  // moving fast keeps its shape relative to the body, where a full-inertia cape trails behind.
+  // Where the middle of the bottom row ends up relative to the body, after the body accelerates (or not).
+  auto relative = [](btScalar inertia, bool moving) {
+    World w;
+    btRigidBody* body = w.addKinematic(new btSphereShape(0.05f), btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+    cape::bullet::CapeActionSettings s;
+    s.linearInertia = inertia;
+    s.discoverColliders = false;
+    CapeAction action(cornerFabric(), cape::CapeSettings(), btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f)), s);
+    action.attachRow(0, body);
+    w.world->addAction(&action);
+    for (int frame = 0; frame < 60; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+    for (int frame = 1; frame <= 12; ++frame) {
+      const float x = moving ? -2.0f * float(frame * frame) / 144.0f : 0.0f;  // 0 -> 20 m/s in 0.2 s
+      World::moveKinematic(body, btTransform(btQuaternion::getIdentity(), btVector3(x, 1.5f, 0)));
+      w.world->stepSimulation(kFrame, 8, kFixed);
+    }
+    const btVector3 r = action.position(19 * 20 + 10) - body->getWorldTransform().getOrigin();
+    w.world->removeAction(&action);
+    return r;
+  };
+  const btVector3 still = relative(1, false);
+  const btScalar glued = (relative(0, true) - still).length(), free = (relative(1, true) - still).length();
+  EXPECT_LT(glued, 1e-3f);
+  EXPECT_GT(free, 0.05f);
+}
+
+TEST(CapeAction, DebugDrawDrawsEveryTriangleEdge) {
+  struct Counter : btIDebugDraw {
+    int lines = 0;
+    void drawLine(const btVector3&, const btVector3&, const btVector3&) override { ++lines; }
+    void drawContactPoint(const btVector3&, const btVector3&, btScalar, int, const btVector3&) override {}
+    void reportErrorWarning(const char*) override {}
+    void draw3dText(const btVector3&, const char*) override {}
+    void setDebugMode(int) override {}
+    int getDebugMode() const override { return DBG_DrawWireframe; }
+  } counter;
+  CapeAction action(cornerFabric(), cape::CapeSettings());
+  action.debugDraw(&counter);
+  EXPECT_EQ(counter.lines, 3 * 2 * 19 * 19);
+}
