@@ -399,6 +399,7 @@ void CapeAction::buildColliders() {
 
 void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   if (!ok() || world == nullptr || !(dt > 0)) return;
+  const auto start = std::chrono::steady_clock::now();
   dropMissing(world);
   discover(world);
   advancePoses(dt);
@@ -406,6 +407,7 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   updatePins();
   applyInertia();  // after the pins have their new targets: it shifts where they start
   buildColliders();
+  prepareMicroseconds_ = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
 }
 
 void CapeAction::advance(btScalar dt) {
@@ -417,7 +419,9 @@ void CapeAction::advance(btScalar dt) {
   if (!convexParts_.empty()) convexPass(dt);
   if (!concaveParts_.empty()) concavePass(dt);
   ++stepCount_;
-  lastStepMicroseconds_ = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  lastStepMicroseconds_ =
+      prepareMicroseconds_ + std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  prepareMicroseconds_ = 0.0;
   accumulatedMicroseconds_ += lastStepMicroseconds_;
 }
 

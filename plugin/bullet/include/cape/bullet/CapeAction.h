@@ -139,10 +139,10 @@ class CapeAction : public btActionInterface {
   /// Particle positions, m, world (one row per particle, columns x, y, z).
   const Points& positions() const { return cape_.state().positions; }
   btVector3 position(std::uint32_t particle) const;
-  /// Wall time of the last advance() (the cape's own work in one internal step), microseconds.
+  /// Wall time of the cape's own work in the last internal step (prepare() and advance()), microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
-  /// Wall time of every advance() since the last call of this function, microseconds (a frame's cape time
-  /// when called once per stepSimulation).
+  /// Sum of lastStepMicroseconds() over the internal steps since the last call of this function (a frame's
+  /// cape time when called once per stepSimulation).
   double takeAccumulatedMicroseconds();
   /// True when the last step teleported the cape.
   bool teleportedLastStep() const { return teleported_; }
@@ -210,6 +210,7 @@ class CapeAction : public btActionInterface {
   bool teleported_ = false;
   std::uint64_t stepCount_ = 0;
   double lastStepMicroseconds_ = 0.0;
+  double prepareMicroseconds_ = 0.0;
   double accumulatedMicroseconds_ = 0.0;
   btVector3 debugColor_{btScalar(0.9), btScalar(0.2), btScalar(0.2)};
 };
