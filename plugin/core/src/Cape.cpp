@@ -168,7 +168,11 @@ void Cape::teleport(const Pose& delta) {
 
 void Cape::step(float dt, ColliderSpan colliders) {
   if (!ok() || !std::isfinite(dt) || !(dt > 0.0f)) return;
-  int substeps = settings_.substeps;
+  // settings.substeps are per settings.timeStep: a step of another length keeps the substep length, so a
+  // world stepping at 1/240 s takes one substep where a 1/60 s frame takes three (the 1e-3 keeps dt =
+  // timeStep at exactly `substeps` despite rounding).
+  const float targetSubstep = settings_.timeStep / static_cast<float>(settings_.substeps);
+  int substeps = std::max(1, static_cast<int>(std::ceil(dt / targetSubstep - 1e-3f)));
   if (settings_.integrator == Integrator::ExplicitSpring) {
     // A longer step than the settings were checked for: split it further rather than blow up.
     const float hMax = explicitStableStep(*fabric_, settings_);

@@ -53,8 +53,9 @@ class Cape {
   /// velocities with it: what a teleport of the character does to its cape, without stretching it.
   void teleport(const Pose& delta);
 
-  /// Advances the cape by dt seconds (settings().substeps substeps) against the colliders, which are swept
-  /// from their previous to their current pose. Non-finite or non-positive dt is ignored.
+  /// Advances the cape by dt seconds against the colliders, which are swept from their previous to their
+  /// current pose, in substeps of about settings().timeStep / settings().substeps (see CapeSettings::substeps).
+  /// Non-finite or non-positive dt is ignored.
   void step(float dt, ColliderSpan colliders);
 
   /// A particle that touched a collider in this substep's collision pass (index into the step's colliders).

@@ -53,15 +53,16 @@ struct CapeSettings {
   float collisionThickness = 0.01f;
   /// Coulomb friction coefficient against colliders.
   float friction = 0.3f;
-  /// Substeps per call to step() (h = dt / substeps), >= 1. Three meet the walk scene's strain bounds
-  /// (median 1.3 %, p95 2.1 %) at 1/60 s frames; see the README for the measurements.
+  /// Substeps per `timeStep`, >= 1: step(dt) takes ceil(dt / (timeStep / substeps)) substeps of equal
+  /// length, so a Bullet world stepping at 1/240 s takes one per internal step where a 1/60 s frame takes
+  /// three. Three per 1/60 s meet the walk scene's strain bounds (median 1.3 %, p95 2.1 %); see the README.
   int substeps = 3;
   /// Constraint iterations per substep, >= 1.
   int iterations = 1;
   /// Gravity, m/s^2.
   Vec3 gravity = Vec3(0.0f, -9.8f, 0.0f);
-  /// The frame time the settings are tuned for, s (informational and used by validate() to check the explicit
-  /// mode's stability bound).
+  /// The frame time the settings are tuned for, s: `substeps` are per this long, and validate() checks the
+  /// explicit mode's stability bound at timeStep / substeps.
   float timeStep = 1.0f / 60.0f;
 
   WindSettings wind;
