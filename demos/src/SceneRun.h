@@ -1,6 +1,5 @@
-// A scene as the demos run it: one or more characters, each with a cape, advanced one 1/60 s frame at a time.
-// Two kinds: the simple body of SCENARIOS.md driven by the core alone, and a URDF character in a Bullet
-// world with the cape attached through the Bullet adapter.
+// A scene as the demos run it: one or more characters, each with a cape, advanced one 1/60 s frame at a time
+// in a Bullet world (BulletScene.h), the cape attached through the Bullet adapter.
 #pragma once
 
 #include "cape/core/Metrics.h"
@@ -43,13 +42,8 @@ class SceneRun {
   virtual std::string describe() const = 0;
 };
 
-/// The simple body of SCENARIOS.md, no Bullet.
-std::unique_ptr<SceneRun> makeSimpleBodyRun(const RunOptions& options, std::string& error);
-
-}  // namespace cape::demo
-
-namespace cape::demo {
-/// The run the options ask for: the simple body, or a URDF character in a Bullet world. nullptr and a
-/// one-line reason on bad input (unreadable URDF, unknown link).
+/// The run the options ask for: the shipped humanoid, a URDF character or the simple body, in a Bullet
+/// world, with our cape on each character (BulletCapeRun.cpp). nullptr and a one-line reason on bad input
+/// (unreadable URDF, unknown link).
 std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& error);
 }  // namespace cape::demo

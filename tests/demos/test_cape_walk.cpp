@@ -78,6 +78,74 @@ TEST(CapeWalk, SimpleBodyWalkWritesEveryOutput) {
   expectRunFolder(dir, 30, 8, 1, 5);
 }
 
+TEST(CapeWalk, ShippedHumanoidByDefault) {
+  const fs::path dir = freshDir();
+  const Result r = run(kWalk + " --size 8 --seconds 0.25 --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream in(dir / "summary.json");
+  const json s = json::parse(in);
+  EXPECT_NE(s["body"].get<std::string>().find("humanoid"), std::string::npos) << s["body"];
+  EXPECT_NE(s["body"].get<std::string>().find("left_shoulder"), std::string::npos) << s["body"];
+  // Every collision element of the humanoid is a collider of the metrics and of colliders.jsonl.
+  const json first = json::parse(lines(dir / "colliders.jsonl").front());
+  EXPECT_GT(first["colliders"].size(), 10u);
+  expectRunFolder(dir, 15, 8, 1, static_cast<int>(first["colliders"].size()));
+  EXPECT_LT(s["summary"]["pin_error_max_m"].get<double>(), 1e-5);
+}
+
+TEST(CapeWalk, UrdfWithNamedAttachmentLinks) {
+  const fs::path dir = freshDir();
+  // A two-link body: a torso box and a "neck" sphere; no link is called shoulder, so --attach names it.
+  const fs::path urdf = dir / "post.urdf";
+  std::ofstream(urdf) << R"(<robot name="post">
+  <link name="base"><collision><origin xyz="0 0 0.7"/><geometry><box size="0.2 0.3 1.4"/></geometry></collision></link>
+  <link name="neck"><collision><geometry><sphere radius="0.08"/></geometry></collision></link>
+  <joint name="fix" type="fixed"><parent link="base"/><child link="neck"/><origin xyz="0 0 1.52"/></joint>
+</robot>)";
+  Result r = run(kWalk + " --urdf " + urdf.string() + " --scene hang --size 6 --seconds 0.1 --out " + (dir / "a").string());
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.output.find("--attach"), std::string::npos) << "says how to name the links: " << r.output;
+  r = run(kWalk + " --urdf " + urdf.string() + " --attach nose --size 6 --seconds 0.1 --out " + (dir / "b").string());
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.output.find("unknown link \"nose\""), std::string::npos) << r.output;
+  r = run(kWalk + " --urdf " + urdf.string() + " --attach neck --scene hang --size 6 --seconds 0.5 --out " + (dir / "c").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  expectRunFolder(dir / "c", 30, 6, 1, 2);
+}
+
+TEST(CapeWalk, MalformedUrdfFailsWithAReason) {
+  const fs::path dir = freshDir();
+  const fs::path urdf = dir / "broken.urdf";
+  std::ofstream(urdf) << "<robot name='x'><link name='a'></robot>";
+  const Result r = run(kWalk + " --urdf " + urdf.string() + " --out " + (dir / "x").string());
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.output.find("broken.urdf"), std::string::npos) << r.output;
+}
+
+TEST(CapeWalk, CrowdResultsDoNotDependOnTheThreadCount) {
+  const fs::path dir = freshDir();
+  std::vector<std::string> strain[2];
+  for (int threads = 1; threads <= 2; ++threads) {
+    const fs::path out = dir / ("t" + std::to_string(threads));
+    const Result r = run(kWalk + " --scene crowd --characters 3 --threads " + std::to_string(threads) +
+                         " --size 8 --seconds 0.5 --out " + out.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    // Everything but the timing columns (2 and 3).
+    for (const std::string& l : lines(out / "metrics.csv")) {
+      std::vector<std::string> cells;
+      std::size_t start = 0;
+      for (std::size_t comma; (comma = l.find(',', start)) != std::string::npos; start = comma + 1) cells.push_back(l.substr(start, comma - start));
+      cells.push_back(l.substr(start));
+      cells.erase(cells.begin() + 2, cells.begin() + 4);
+      std::string joined;
+      for (const std::string& c : cells) joined += c + ",";
+      strain[threads - 1].push_back(joined);
+    }
+    EXPECT_EQ(lines(out / "frames" / "k2" / "00030.obj"), lines(dir / "t1" / "frames" / "k2" / "00030.obj"));
+  }
+  EXPECT_EQ(strain[0], strain[1]);
+}
+
 TEST(CapeWalk, CrowdWritesFramesPerCharacter) {
   const fs::path dir = freshDir();
   const Result r = run(kWalk + " --simple-body --scene crowd --characters 3 --size 6 --seconds 0.25 --out " + dir.string());

@@ -1,0 +1,76 @@
+// Our cape on the scene's Bullet world: one CapeAction per character, stepped together by a CapeGroup (on
+// --threads workers) inside stepSimulation.
+#include "BulletScene.h"
+
+#include "cape/bullet/CapeAction.h"
+#include "cape/bullet/CapeGroup.h"
+#include "cape/bullet/Convert.h"
+
+#include <cstdio>
+
+namespace cape::demo {
+
+namespace {
+
+class BulletCapeRun final : public SceneRun {
+ public:
+  BulletCapeRun(std::unique_ptr<BulletScene> scene, int threads)
+      : scene_(std::move(scene)), group_(std::make_unique<bullet::CapeGroup>(threads)) {}
+  ~BulletCapeRun() override {
+    scene_->world().removeAction(group_.get());
+    group_.reset();
+    capes_.clear();
+  }
+
+  bool build(const CapeSettings& settings, SceneKind kind, std::string& error) {
+    for (int k = 0; k < scene_->characterCount(); ++k) {
+      auto cape = std::make_unique<bullet::CapeAction>(scene_->rig().fabric, settingsForScene(kind, settings),
+                                                       bullet::toBt(scene_->capePlacement(k)));
+      if (!cape->ok()) {
+        error = cape->cape().status().message();
+        return false;
+      }
+      for (const PinSpec& p : scene_->pins(k)) cape->attach(p.particle, p.body, p.localPivot);
+      group_->add(cape.get());
+      capes_.push_back(std::move(cape));
+    }
+    scene_->world().addAction(group_.get());
+    return true;
+  }
+
+  int characterCount() const override { return scene_->characterCount(); }
+  void advanceFrame() override {
+    ++frame_;
+    frameUs_ = scene_->stepFrame(frame_ / 60.0);
+    capeUs_ = 0.0;
+    for (auto& c : capes_) capeUs_ += c->takeAccumulatedMicroseconds();
+    // With several workers the capes run at once: their summed work overstates the wall time they took.
+    if (group_->threadCount() > 1) capeUs_ = std::min(capeUs_, frameUs_);
+  }
+  const Cape& cape(int k) const override { return capes_[static_cast<std::size_t>(k)]->cape(); }
+  std::vector<Collider> bodyColliders(int k) const override { return scene_->bodyColliders(k); }
+  Vec3 torsoCentre(int k) const override { return scene_->torsoCentre(k); }
+  double lastFrameTimeUs() const override { return frameUs_; }
+  double lastCapeTimeUs() const override { return capeUs_; }
+  std::string describe() const override { return scene_->describe(); }
+
+ private:
+  std::unique_ptr<BulletScene> scene_;
+  std::unique_ptr<bullet::CapeGroup> group_;
+  std::vector<std::unique_ptr<bullet::CapeAction>> capes_;
+  int frame_ = 0;
+  double frameUs_ = 0.0, capeUs_ = 0.0;
+};
+
+}  // namespace
+
+std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& error) {
+  std::unique_ptr<BulletScene> scene = BulletScene::create(options, error);
+  if (!scene) return nullptr;
+  for (const std::string& w : scene->warnings()) std::fprintf(stderr, "cape_walk: warning: %s\n", w.c_str());
+  auto run = std::make_unique<BulletCapeRun>(std::move(scene), options.threads);
+  if (!run->build(options.settings, options.scene, error)) return nullptr;
+  return run;
+}
+
+}  // namespace cape::demo

@@ -1,0 +1,89 @@
+// The canonical scenes of shared/SCENARIOS.md in a Bullet world: each character as kinematic rigid bodies
+// (the shipped humanoid or a URDF through the character library, or the simple body of SCENARIOS.md), a
+// static ground plane, and where each character's cape starts and which bodies it is pinned to. The world is
+// stepped as SCENARIOS.md says: stepSimulation(1/60, 8, 1/240). cape_walk puts our cape on it; cape_compare
+// puts our cape on one and the btSoftBody twin on another.
+#pragma once
+
+#include "SceneRun.h"
+
+#include "cape/character/Character.h"
+
+#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+#include <btBulletDynamicsCommon.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace cape::demo {
+
+/// A cape particle pinned to a body at a point in the body's frame (m).
+struct PinSpec {
+  std::uint32_t particle = 0;
+  btRigidBody* body = nullptr;
+  btVector3 localPivot{0, 0, 0};
+};
+
+class BulletScene {
+ public:
+  /// Builds the world and its characters for the options; nullptr and a one-line reason on bad input
+  /// (unreadable or malformed URDF, unknown attachment link, no link to attach to).
+  static std::unique_ptr<BulletScene> create(const RunOptions& options, std::string& error);
+  ~BulletScene();
+  BulletScene(const BulletScene&) = delete;
+  BulletScene& operator=(const BulletScene&) = delete;
+
+  btSoftRigidDynamicsWorld& world() { return *world_; }
+  btSoftBodyWorldInfo& softBodyWorldInfo() { return worldInfo_; }
+  int characterCount() const { return static_cast<int>(characters_.size()); }
+  /// The cape every character wears (fabric, pinned particles).
+  const CapeRig& rig() const { return rig_; }
+  /// The scene's motion (its length, speeds).
+  const MotionDesc& motion() const { return motion_; }
+
+  /// Moves every character to its pose at time t (s), then steps the world one 1/60 s frame; returns the
+  /// wall time of the stepSimulation call, µs.
+  double stepFrame(double t);
+
+  /// A character's body colliders at its current pose (true surfaces, ground excluded), for the metrics and
+  /// colliders.jsonl.
+  std::vector<Collider> bodyColliders(int character) const;
+  /// Where the blow-up metric measures from: the torso's centre.
+  Vec3 torsoCentre(int character) const;
+  /// The cape's starting placement in the world (world = placement * fabric rest shape).
+  Pose capePlacement(int character) const;
+  /// The cape's pins: particles, bodies and body-frame pivots.
+  const std::vector<PinSpec>& pins(int character) const;
+  /// One line for summary.json: the body, the attachment links, the stepping.
+  std::string describe() const;
+  /// Load and mapping warnings worth printing once (meshes left out, joints the gait could not map).
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  struct Character;
+  BulletScene() = default;
+  bool build(const RunOptions& options, std::string& error);
+  void poseAt(double t);
+
+  // Bullet's world, in construction order (destroyed in reverse).
+  std::unique_ptr<btSoftBodyRigidBodyCollisionConfiguration> configuration_;
+  std::unique_ptr<btCollisionDispatcher> dispatcher_;
+  std::unique_ptr<btDbvtBroadphase> broadphase_;
+  std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
+  std::unique_ptr<btSoftRigidDynamicsWorld> world_;
+  btSoftBodyWorldInfo worldInfo_;
+  std::unique_ptr<btStaticPlaneShape> groundShape_;
+  std::unique_ptr<btRigidBody> ground_;
+
+  RunOptions options_;
+  MotionDesc motion_;
+  CapeRig rig_;
+  std::vector<std::unique_ptr<Character>> characters_;
+  std::vector<std::string> attachLinks_;
+  std::string body_;
+  std::vector<std::string> warnings_;
+};
+
+}  // namespace cape::demo
