@@ -82,11 +82,9 @@ bool BulletScene::build(const RunOptions& o, std::string& error) {
   world_ = std::make_unique<btSoftRigidDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
                                                        configuration_.get());
   world_->setGravity(btVector3(0, btScalar(-9.8), 0));
-  worldInfo_.m_broadphase = broadphase_.get();
-  worldInfo_.m_dispatcher = dispatcher_.get();
-  worldInfo_.m_gravity = world_->getGravity();
-  worldInfo_.m_sparsesdf.Initialize();
-  world_->getWorldInfo() = worldInfo_;
+  // Soft bodies (the btSoftBody twin of cape_compare) take gravity and air from the world's soft body info.
+  world_->getWorldInfo().m_gravity = world_->getGravity();
+  world_->getWorldInfo().air_density = btScalar(1.2);
 
   groundShape_ = std::make_unique<btStaticPlaneShape>(btVector3(0, 1, 0), btScalar(0));
   ground_ = std::make_unique<btRigidBody>(btScalar(0), nullptr, groundShape_.get());

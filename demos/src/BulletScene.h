@@ -36,7 +36,6 @@ class BulletScene {
   BulletScene& operator=(const BulletScene&) = delete;
 
   btSoftRigidDynamicsWorld& world() { return *world_; }
-  btSoftBodyWorldInfo& softBodyWorldInfo() { return worldInfo_; }
   int characterCount() const { return static_cast<int>(characters_.size()); }
   /// The cape every character wears (fabric, pinned particles).
   const CapeRig& rig() const { return rig_; }
@@ -73,7 +72,6 @@ class BulletScene {
   std::unique_ptr<btDbvtBroadphase> broadphase_;
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
   std::unique_ptr<btSoftRigidDynamicsWorld> world_;
-  btSoftBodyWorldInfo worldInfo_;
   std::unique_ptr<btStaticPlaneShape> groundShape_;
   std::unique_ptr<btRigidBody> ground_;
 

@@ -144,11 +144,11 @@ json summaryFigures(const std::vector<FrameRow>& rows, const RunSummary& q) {
   return j;
 }
 
-fs::path freshRunFolder(const std::string& scene) {
+fs::path freshRunFolder(const std::string& scene, const std::string& prefix) {
   char stamp[32];
   const std::time_t now = std::time(nullptr);
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
-  fs::path base = "cape_run_" + scene + "_" + stamp;
+  fs::path base = prefix + "_" + scene + "_" + stamp;
   fs::path dir = base;
   for (int k = 2; fs::exists(dir); ++k) dir = base.string() + "-" + std::to_string(k);
   return dir;

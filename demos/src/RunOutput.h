@@ -54,7 +54,7 @@ class RunWriter {
 /// Summary figures of a run, the timings over frames 11..end as SCENARIOS.md defines them.
 nlohmann::json summaryFigures(const std::vector<FrameRow>& rows, const RunSummary& quality);
 
-/// A fresh folder name in the current directory: cape_run_<scene>_<YYYYmmdd-HHMMSS>[-N].
-std::filesystem::path freshRunFolder(const std::string& scene);
+/// A fresh folder name in the current directory: <prefix>_<scene>_<YYYYmmdd-HHMMSS>[-N].
+std::filesystem::path freshRunFolder(const std::string& scene, const std::string& prefix = "cape_run");
 
 }  // namespace cape::demo

@@ -1,0 +1,323 @@
+// cape_compare: the same scene (same character, colliders, attachments, stepping) with our cape and with the
+// btSoftBody twin, side by side. Prints one row per solver with every metric of shared/SCENARIOS.md, the
+// frame and cape times and each solver's cape time relative to ours; writes compare.csv, compare.json,
+// per-frame CSVs and PNG plots. `cape_compare --help` lists the options.
+#include "BulletScene.h"
+#include "Plots.h"
+#include "Progress.h"
+#include "RunOutput.h"
+
+#include "cape/bullet/CapeAction.h"
+#include "cape/bullet/Convert.h"
+#include "cape/bullet/SoftBodyTwin.h"
+
+#include <BulletSoftBody/btSoftBody.h>
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+using namespace cape;
+using namespace cape::demo;
+using nlohmann::json;
+
+namespace {
+
+/// One solver's run: per-frame metrics and timings, and its settings as printed.
+struct SolverResult {
+  std::string name;
+  json settings;
+  std::vector<FrameRow> rows;
+  MetricsRecorder recorder;
+};
+
+/// The per-frame row of a crowd holds the worst of its characters.
+void mergeWorst(FrameMetrics& into, const FrameMetrics& m, bool first) {
+  into.maxStrain = first ? m.maxStrain : std::max(into.maxStrain, m.maxStrain);
+  into.meanStrain = std::max(into.meanStrain, m.meanStrain);
+  into.maxPenetration = std::max(into.maxPenetration, m.maxPenetration);
+  into.selfIntersections = std::max(into.selfIntersections, m.selfIntersections);
+  into.pinError = std::max(into.pinError, m.pinError);
+  into.meanSpeed = std::max(into.meanSpeed, m.meanSpeed);
+  into.blowUp = into.blowUp || m.blowUp;
+}
+
+/// The btSoftBody twins of every character of a scene, and the metrics measured on them exactly as on ours.
+class TwinRun {
+ public:
+  bool build(const RunOptions& o, const bullet::SoftBodyTwinSettings& twin, std::string& error) {
+    scene_ = BulletScene::create(o, error);
+    if (!scene_) return false;
+    const CapeSettings settings = settingsForScene(o.scene, o.settings);
+    for (int k = 0; k < scene_->characterCount(); ++k) {
+      // A cape action (never added to the world) places the cape and holds the attachments the twin copies.
+      auto proto = std::make_unique<bullet::CapeAction>(scene_->rig().fabric, settings, bullet::toBt(scene_->capePlacement(k)));
+      for (const PinSpec& p : scene_->pins(k)) proto->attach(p.particle, p.body, p.localPivot);
+      std::unique_ptr<btSoftBody> body = bullet::makeSoftBodyTwin(scene_->world(), *proto, twin);
+      if (!body) {
+        error = "cannot build the btSoftBody twin";
+        return false;
+      }
+      if (settings.wind.model != WindSettings::Model::None) {
+        // Bullet's own aerodynamics, two-sided, in the mean wind (btSoftBody has no gust field).
+        body->m_cfg.aeromodel = btSoftBody::eAeroModel::V_TwoSided;
+        body->m_cfg.kDG = btScalar(settings.wind.dragCoefficient);
+        body->m_cfg.kLF = btScalar(settings.wind.liftCoefficient);
+        body->setWindVelocity(bullet::toBt(settings.wind.direction.normalized() * settings.wind.speed));
+      }
+      positions_.push_back(Points::Zero(static_cast<Eigen::Index>(body->m_nodes.size()), 3));
+      counters_.emplace_back();
+      protos_.push_back(std::move(proto));
+      bodies_.push_back(std::move(body));
+    }
+    return true;
+  }
+  ~TwinRun() {
+    if (scene_)
+      for (auto& b : bodies_) scene_->world().removeSoftBody(b.get());
+  }
+  double stepFrame(double t) { return scene_->stepFrame(t); }
+  FrameMetrics measure(int k) {
+    const btSoftBody& body = *bodies_[static_cast<std::size_t>(k)];
+    Points& x = positions_[static_cast<std::size_t>(k)];
+    for (int i = 0; i < body.m_nodes.size(); ++i) x.row(i) = bullet::toVec3(body.m_nodes[i].m_x).transpose();
+    const Fabric& fabric = scene_->rig().fabric ? *scene_->rig().fabric : throw std::logic_error("no fabric");
+    FrameMetrics m;
+    const StrainStats strain = structuralStrain(fabric, x);
+    m.maxStrain = strain.max;
+    m.meanStrain = strain.mean;
+    m.maxPenetration = maxPenetration(x, scene_->bodyColliders(k));
+    m.selfIntersections = counters_[static_cast<std::size_t>(k)].count(fabric, x);
+    for (const PinSpec& p : scene_->pins(k)) {
+      const btVector3 target = p.body->getWorldTransform() * p.localPivot;
+      m.pinError = std::max(m.pinError, static_cast<float>((body.m_nodes[static_cast<int>(p.particle)].m_x - target).length()));
+    }
+    double speed = 0.0;
+    for (int i = 0; i < body.m_nodes.size(); ++i) speed += body.m_nodes[i].m_v.length();
+    m.meanSpeed = static_cast<float>(speed / std::max(1, body.m_nodes.size()));
+    m.blowUp = isBlownUp(x, scene_->torsoCentre(k));
+    return m;
+  }
+  int characterCount() const { return scene_->characterCount(); }
+  const Fabric& fabric() const { return *scene_->rig().fabric; }
+
+ private:
+  std::unique_ptr<BulletScene> scene_;
+  std::vector<std::unique_ptr<bullet::CapeAction>> protos_;
+  std::vector<std::unique_ptr<btSoftBody>> bodies_;
+  std::vector<Points> positions_;
+  std::vector<SelfIntersectionCounter> counters_;
+};
+
+json capeSettingsJson(const CapeSettings& s) {
+  return {{"integrator", toString(s.integrator)}, {"substeps_per_frame", s.substeps}, {"iterations", s.iterations},
+          {"structural_stiffness_n_per_m", s.structuralStiffness}, {"shear_stiffness_n_per_m", s.shearStiffness},
+          {"bend_stiffness_n_per_m", s.bendStiffness}, {"tethers", s.useTethers}, {"damping_per_s", s.damping},
+          {"collision_thickness_m", s.collisionThickness}, {"friction", s.friction},
+          {"self_collision", s.selfCollision}};
+}
+
+json twinSettingsJson(const bullet::SoftBodyTwinSettings& t) {
+  return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") + (t.bendLinks ? "bend" : "")},
+          {"piterations", t.positionIterations}, {"viterations", t.velocityIterations},
+          {"diterations", t.driftIterations}, {"kLST", t.linearStiffness}, {"kDP", t.damping},
+          {"kDF", t.friction}, {"kAHR", t.anchorHardness}, {"kCHR", t.rigidContactHardness},
+          {"margin_m", t.margin}, {"collisions", "SDF_RS"}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"cape_compare: the same scene with our cape and with Bullet's btSoftBody twin, side by side; prints "
+               "every metric of SCENARIOS.md per solver and writes compare.csv, compare.json and PNG plots."};
+  std::string scene = "walk", attachment = "corners", out, urdf, attach;
+  int size = 20, characters = 3, iterations = 10;
+  double seconds = -1.0;
+  bool simpleBody = false, noPlots = false;
+  app.add_option("--scene", scene, "hang | walk | sprint-turn | wind | crowd")
+      ->check(CLI::IsMember({"hang", "walk", "sprint-turn", "wind", "crowd"}))
+      ->capture_default_str();
+  app.add_option("--size", size, "particles per side of the N x N cape")->check(CLI::Range(2, 128))->capture_default_str();
+  app.add_option("--attachment", attachment, "corners | collar")->check(CLI::IsMember({"corners", "collar"}))->capture_default_str();
+  app.add_option("--seconds", seconds, "simulated length, s (default: the scene's own length)")->check(CLI::PositiveNumber);
+  app.add_option("--characters", characters, "characters in the crowd scene")->check(CLI::Range(1, 32))->capture_default_str();
+  app.add_flag("--simple-body", simpleBody, "the simple body of SCENARIOS.md instead of the shipped humanoid");
+  app.add_option("--urdf", urdf, "character URDF file (default: the shipped humanoid)")->check(CLI::ExistingFile);
+  app.add_option("--attach", attach, "comma-separated links the cape pins to (default: links named *shoulder*)");
+  app.add_option("--softbody-iterations", iterations, "btSoftBody position iterations (m_cfg.piterations)")
+      ->check(CLI::Range(1, 200))
+      ->capture_default_str();
+  app.add_option("--out", out, "output folder (default: a fresh cape_compare_<scene>_<time> folder)");
+  app.add_flag("--no-plots", noPlots, "do not draw the PNG plots");
+  CLI11_PARSE(app, argc, argv);
+
+  RunOptions o;
+  parseSceneKind(scene, o.scene);
+  parseAttachment(attachment, o.attachment);
+  o.size = size;
+  o.seconds = seconds;
+  o.characters = o.scene == SceneKind::Crowd ? characters : 1;
+  o.simpleBody = simpleBody;
+  o.urdf = urdf;
+  for (std::size_t start = 0; !attach.empty();) {
+    const std::size_t comma = attach.find(',', start);
+    const std::string link = attach.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (!link.empty()) o.attachLinks.push_back(link);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+
+  // The twin's settings: the same masses, springs (structural + shear, the King's graph; bend springs
+  // soften btSoftBody's stretch resistance and are left out), friction, thickness and air drag as ours
+  // (btSoftBody damps by (1 - kDP) per step, ours by 1 / (1 + c h)); its stiffest material, and as many
+  // position iterations as asked for (10 by default, the figure the issue quotes).
+  bullet::SoftBodyTwinSettings twin;
+  const double h = 1.0 / 240.0;
+  const double c = o.settings.damping;
+  twin.positionIterations = iterations;
+  twin.linearStiffness = 1;
+  twin.damping = btScalar(c * h / (1.0 + c * h));
+  twin.friction = btScalar(o.settings.friction);
+  twin.margin = btScalar(o.settings.collisionThickness);
+
+  std::string error;
+  std::unique_ptr<SceneRun> ours = makeSceneRun(o, error);
+  if (!ours) {
+    std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
+    return 1;
+  }
+  TwinRun twinRun;
+  if (!twinRun.build(o, twin, error)) {
+    std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
+    return 1;
+  }
+  // The same world with no cape at all: the rigid share of a frame, so that the twin's cape time is its
+  // frame time less this (btSoftBody's work happens inside stepSimulation, where it cannot be timed alone).
+  std::unique_ptr<BulletScene> bare = BulletScene::create(o, error);
+  if (!bare) {
+    std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
+    return 1;
+  }
+
+  const std::filesystem::path dir = out.empty() ? freshRunFolder(scene, "cape_compare") : std::filesystem::path(out);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    std::fprintf(stderr, "cape_compare: cannot create %s: %s\n", dir.c_str(), ec.message().c_str());
+    return 1;
+  }
+
+  const double length = o.seconds > 0.0 ? o.seconds : MotionDesc::forScene(o.scene).duration;
+  const int frames = static_cast<int>(std::lround(length * 60.0));
+  SolverResult results[2];
+  results[0].name = "ours (XPBD cape)";
+  results[0].settings = capeSettingsJson(settingsForScene(o.scene, o.settings));
+  results[1].name = "btSoftBody twin";
+  results[1].settings = twinSettingsJson(twin);
+  std::vector<SelfIntersectionCounter> counters(static_cast<std::size_t>(ours->characterCount()));
+  Progress progress("cape_compare " + scene, frames);
+  for (int f = 1; f <= frames; ++f) {
+    const double t = f / 60.0;
+    // Interleaved, so that the machine's noise falls on every solver alike.
+    ours->advanceFrame();
+    const double twinFrame = twinRun.stepFrame(t);
+    const double bareFrame = bare->stepFrame(t);
+
+    FrameRow a{f, t, ours->lastFrameTimeUs(), ours->lastCapeTimeUs(), {}};
+    for (int k = 0; k < ours->characterCount(); ++k)
+      mergeWorst(a.metrics, measureFrame(ours->cape(k), ours->bodyColliders(k), ours->torsoCentre(k), &counters[static_cast<std::size_t>(k)]), k == 0);
+    FrameRow b{f, t, twinFrame, std::max(0.0, twinFrame - bareFrame), {}};
+    for (int k = 0; k < twinRun.characterCount(); ++k) mergeWorst(b.metrics, twinRun.measure(k), k == 0);
+    results[0].rows.push_back(a);
+    results[0].recorder.add(a.metrics);
+    results[1].rows.push_back(b);
+    results[1].recorder.add(b.metrics);
+    progress.update(f);
+  }
+  progress.finish();
+
+  // The table, compare.csv and compare.json.
+  json compare;
+  compare["scene"] = scene;
+  compare["body"] = ours->describe();
+  compare["grid"] = {{"columns", size}, {"rows", size}, {"particles", size * size}};
+  compare["frames"] = frames;
+  const json ourSummary = summaryFigures(results[0].rows, results[0].recorder.summary());
+  const double ourCape = ourSummary["cape_time_us_median"].get<double>();
+  std::ofstream csv(dir / "compare.csv");
+  csv << "solver,frame_time_us_median,cape_time_us_median,cape_time_us_p95,cape_time_ratio_to_ours,max_strain,"
+         "mean_strain,p95_frame_max_strain,max_penetration_m,frames_penetration_over_1mm,self_intersections_max,"
+         "pin_error_max_m,blow_up\n";
+  std::printf("cape_compare: scene %s, %d x %d cape, %d frames -> %s\n%s\n", scene.c_str(), size, size, frames,
+              dir.c_str(), ours->describe().c_str());
+  std::printf("%-18s %9s %9s %9s %7s %8s %8s %9s %6s %6s %9s %6s\n", "solver", "frame us", "cape us", "cape p95",
+              "x ours", "strain", "mean", "pen m", ">1mm", "self", "pin m", "blowup");
+  for (SolverResult& r : results) {
+    const RunSummary q = r.recorder.summary();
+    json s = summaryFigures(r.rows, q);
+    const double ratio = ourCape > 0.0 ? s["cape_time_us_median"].get<double>() / ourCape : 0.0;
+    json row = {{"name", r.name},
+                {"frame_time_us_median", s["frame_time_us_median"]},
+                {"cape_time_us_median", s["cape_time_us_median"]},
+                {"cape_time_us_p95", s["cape_time_us_p95"]},
+                {"cape_time_ratio_to_ours", ratio},
+                {"max_strain", q.maxStrain},
+                {"mean_strain", q.meanStrain},
+                {"p95_frame_max_strain", q.p95FrameMaxStrain},
+                {"max_penetration_m", q.maxPenetration},
+                {"frames_penetration_over_1mm", q.framesPenetrationOver1mm},
+                {"self_intersections_max", q.selfIntersectionsMax},
+                {"pin_error_max_m", q.pinErrorMax},
+                {"blow_up", q.blowUp},
+                {"settings", r.settings}};
+    compare["solvers"].push_back(row);
+    char line[512];
+    std::snprintf(line, sizeof line, "%s,%.2f,%.2f,%.2f,%.3f,%.6f,%.6f,%.6f,%.6f,%d,%d,%.3g,%d\n", r.name.c_str(),
+                  s["frame_time_us_median"].get<double>(), s["cape_time_us_median"].get<double>(),
+                  s["cape_time_us_p95"].get<double>(), ratio, q.maxStrain, q.meanStrain, q.p95FrameMaxStrain,
+                  q.maxPenetration, q.framesPenetrationOver1mm, q.selfIntersectionsMax, q.pinErrorMax, q.blowUp ? 1 : 0);
+    csv << line;
+    std::printf("%-18s %9.1f %9.1f %9.1f %7.2f %7.2f%% %7.3f%% %9.4f %6d %6d %9.2g %6s\n", r.name.c_str(),
+                s["frame_time_us_median"].get<double>(), s["cape_time_us_median"].get<double>(),
+                s["cape_time_us_p95"].get<double>(), ratio, 100.0 * q.maxStrain, 100.0 * q.meanStrain,
+                q.maxPenetration, q.framesPenetrationOver1mm, q.selfIntersectionsMax, q.pinErrorMax,
+                q.blowUp ? "YES" : "no");
+    // Per-frame rows of each solver.
+    std::ofstream perFrame(dir / (std::string(&r == &results[0] ? "frames_ours" : "frames_btsoftbody") + ".csv"));
+    perFrame << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_intersections,pin_error_m,blow_up\n";
+    for (const FrameRow& fr : r.rows) {
+      std::snprintf(line, sizeof line, "%d,%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%d\n", fr.frame, fr.time, fr.frameTimeUs,
+                    fr.capeTimeUs, fr.metrics.maxStrain, fr.metrics.meanStrain, fr.metrics.maxPenetration,
+                    fr.metrics.selfIntersections, fr.metrics.pinError, fr.metrics.blowUp ? 1 : 0);
+      perFrame << line;
+    }
+  }
+  std::printf("settings:\n  ours:       %s\n  btSoftBody: %s\n", results[0].settings.dump().c_str(),
+              results[1].settings.dump().c_str());
+  std::ofstream(dir / "compare.json") << compare.dump(2) << "\n";
+
+  if (!noPlots) {
+    auto series = [&](auto value) {
+      std::vector<Series> out;
+      for (const SolverResult& r : results) {
+        Series s{r.name, {}, {}};
+        for (const FrameRow& fr : r.rows) {
+          s.x.push_back(fr.time);
+          s.y.push_back(value(fr));
+        }
+        out.push_back(std::move(s));
+      }
+      return out;
+    };
+    const bool drawn =
+        plotLines(dir / "strain.png", "Max structural strain per frame (" + scene + ")", "time, s", "strain, %",
+                  series([](const FrameRow& r) { return 100.0 * r.metrics.maxStrain; }), error) &&
+        plotLines(dir / "penetration.png", "Deepest particle inside a body collider (" + scene + ")", "time, s",
+                  "penetration, mm", series([](const FrameRow& r) { return 1000.0 * r.metrics.maxPenetration; }), error) &&
+        plotLines(dir / "frame_time.png", "Wall time of stepSimulation per frame (" + scene + ")", "time, s",
+                  "frame time, us", series([](const FrameRow& r) { return r.frameTimeUs; }), error);
+    if (!drawn) std::fprintf(stderr, "cape_compare: plots not drawn: %s\n", error.c_str());
+  }
+  return 0;
+}

@@ -1,0 +1,69 @@
+// cape_compare end to end: our cape and the btSoftBody twin on the same scene; compare.json holds one entry
+// per solver (ours first) with every metric, compare.csv the same rows, and the plots are PNG files.
+#include "DemoTestSupport.h"
+
+namespace cape::demo_test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::string kCompare = CAPE_COMPARE;
+
+bool isPng(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  char magic[8] = {};
+  in.read(magic, 8);
+  return in && std::string(magic + 1, 3) == "PNG" && fs::file_size(file) > 1000;
+}
+
+TEST(CapeCompare, WalkWritesOneRowPerSolverAndPlots) {
+  const fs::path dir = freshDir();
+  const Result r = run(kCompare + " --scene walk --size 8 --seconds 0.5 --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("btSoftBody"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("piterations"), std::string::npos) << "prints the btSoftBody settings: " << r.output;
+
+  std::ifstream in(dir / "compare.json");
+  const json j = json::parse(in);
+  EXPECT_EQ(j["scene"], "walk");
+  ASSERT_EQ(j["solvers"].size(), 2u);
+  EXPECT_NE(j["solvers"][0]["name"].get<std::string>().find("ours"), std::string::npos) << "ours first";
+  for (const json& s : j["solvers"]) {
+    for (const char* key : {"name", "frame_time_us_median", "cape_time_us_median", "cape_time_us_p95", "max_strain",
+                            "mean_strain", "max_penetration_m", "frames_penetration_over_1mm", "self_intersections_max",
+                            "pin_error_max_m", "blow_up", "settings"})
+      EXPECT_TRUE(s.contains(key)) << key;
+    EXPECT_FALSE(s["blow_up"].get<bool>());
+    EXPECT_GT(s["frame_time_us_median"].get<double>(), 0.0);
+  }
+  EXPECT_DOUBLE_EQ(j["solvers"][0]["cape_time_ratio_to_ours"].get<double>(), 1.0);
+  // Both solvers kept their pins and the cape on the body (short of blowing up or falling off).
+  EXPECT_LT(j["solvers"][0]["pin_error_max_m"].get<double>(), 1e-5);
+  EXPECT_LT(j["solvers"][1]["pin_error_max_m"].get<double>(), 0.1);
+
+  EXPECT_EQ(lines(dir / "compare.csv").size(), 3u);
+  EXPECT_EQ(lines(dir / "frames_ours.csv").size(), 31u);
+  EXPECT_EQ(lines(dir / "frames_btsoftbody.csv").size(), 31u);
+  for (const char* png : {"strain.png", "penetration.png", "frame_time.png"}) EXPECT_TRUE(isPng(dir / png)) << png;
+}
+
+TEST(CapeCompare, SimpleBodyAndNoPlots) {
+  const fs::path dir = freshDir();
+  const Result r = run(kCompare + " --simple-body --scene sprint-turn --size 6 --seconds 0.25 --no-plots --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "compare.json"));
+  EXPECT_FALSE(fs::exists(dir / "strain.png"));
+}
+
+TEST(CapeCompare, BadOptionsFailWithAReason) {
+  const fs::path dir = freshDir();
+  for (const std::string args : {"--scene dance", "--softbody-iterations 0", "--attach nose", "--urdf /nonexistent.urdf"}) {
+    const Result r = run(kCompare + " " + args + " --seconds 0.1 --out " + (dir / "x").string());
+    EXPECT_NE(r.exitCode, 0) << args;
+    EXPECT_FALSE(r.output.empty()) << args;
+  }
+}
+
+}  // namespace
+}  // namespace cape::demo_test
