@@ -5,9 +5,9 @@
 #include "cape/bullet/CapeAction.h"
 #include "cape/core/Scene.h"
 
-#include <btBulletDynamicsCommon.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+#include <btBulletDynamicsCommon.h>
 
 #include <memory>
 #include <vector>
@@ -36,14 +36,30 @@ struct World {
       w->getWorldInfo().m_dispatcher = dispatcher.get();
       world.reset(w);
     } else {
-      world = std::make_unique<btDiscreteDynamicsWorld>(dispatcher.get(), broadphase.get(), solver.get(), config.get());
+      world = std::make_unique<btDiscreteDynamicsWorld>(dispatcher.get(), broadphase.get(), solver.get(),
+                                                        config.get());
     }
     world->setGravity(btVector3(0, btScalar(-9.8), 0));
   }
   ~World() {
     for (int i = world->getNumCollisionObjects() - 1; i >= 0; --i) {
       btCollisionObject* o = world->getCollisionObjectArray()[i];
-      if (btRigidBody* b = btRigidBody::upcast(o)) world->removeRigidBody(b); else world->removeCollisionObject(o);
+      if (btRigidBody* b = btRigidBody::upcast(o))
+        world->removeRigidBody(b);
+      else
+        world->removeCollisionObject(o);
+    }
+    // Compounds made by the tests own their children here (Bullet's compounds do not delete them).
+    for (auto& shape : shapes) deleteChildren(shape.get());
+  }
+  static void deleteChildren(btCollisionShape* shape) {
+    if (shape == nullptr || shape->getShapeType() != COMPOUND_SHAPE_PROXYTYPE) return;
+    auto* compound = static_cast<btCompoundShape*>(shape);
+    for (int i = compound->getNumChildShapes() - 1; i >= 0; --i) {
+      btCollisionShape* child = compound->getChildShape(i);
+      compound->removeChildShapeByIndex(i);
+      deleteChildren(child);
+      delete child;
     }
   }
   btSoftRigidDynamicsWorld* soft() { return static_cast<btSoftRigidDynamicsWorld*>(world.get()); }
@@ -69,7 +85,9 @@ struct World {
     b->setActivationState(DISABLE_DEACTIVATION);
     return b;
   }
-  static void moveKinematic(btRigidBody* b, const btTransform& t) { b->getMotionState()->setWorldTransform(t); }
+  static void moveKinematic(btRigidBody* b, const btTransform& t) {
+    b->getMotionState()->setWorldTransform(t);
+  }
 
   std::unique_ptr<btCollisionConfiguration> config;
   std::unique_ptr<btCollisionDispatcher> dispatcher;
@@ -82,15 +100,20 @@ struct World {
 };
 
 /// The canonical 20 x 20 cape (0.6 m x 1.0 m, 0.4 kg), tethered to its top corners.
-inline cape::FabricPtr cornerFabric(int n = 20) { return cape::makeCapeRig(n, cape::Attachment::Corners).fabric; }
+inline cape::FabricPtr cornerFabric(int n = 20) {
+  return cape::makeCapeRig(n, cape::Attachment::Corners).fabric;
+}
 
-/// Lying flat and horizontal (rotated +90 degrees about X: the grid spans x in [-0.3, 0.3], z in [-0.5, 0.5]), centred on (0, y, 0).
+/// Lying flat and horizontal (rotated +90 degrees about X: the grid spans x in [-0.3, 0.3], z in [-0.5,
+/// 0.5]), centred on (0, y, 0).
 inline btTransform horizontalAt(btScalar y) {
   btTransform t(btQuaternion(btVector3(1, 0, 0), SIMD_HALF_PI), btVector3(btScalar(-0.3), y, btScalar(0.5)));
   return t;
 }
 
-inline bool allFinite(const cape::Points& x) { return x.allFinite(); }
+inline bool allFinite(const cape::Points& x) {
+  return x.allFinite();
+}
 
 /// Largest structural strain (|xi - xj| - L0) / L0 of the cape.
 inline float maxStructuralStrain(const cape::Cape& c) {

@@ -22,10 +22,13 @@ std::vector<cape::Points> runGroup(int threads) {
   cape::bullet::CapeGroup group(threads);
   for (int k = 0; k < 3; ++k) {
     const btVector3 at(btScalar(2 * k), btScalar(1.5), 0);
-    bodies.push_back(w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)), btTransform(btQuaternion::getIdentity(), at)));
-    w.addStatic(new btSphereShape(0.25f), btTransform(btQuaternion::getIdentity(), at + btVector3(0, -0.6f, 0.3f)));
-    capes.push_back(std::make_unique<CapeAction>(cornerFabric(), cape::CapeSettings(),
-                                                 btTransform(btQuaternion::getIdentity(), at + btVector3(-0.3f, 0.06f, 0.15f))));
+    bodies.push_back(w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)),
+                                    btTransform(btQuaternion::getIdentity(), at)));
+    w.addStatic(new btSphereShape(0.25f),
+                btTransform(btQuaternion::getIdentity(), at + btVector3(0, -0.6f, 0.3f)));
+    capes.push_back(std::make_unique<CapeAction>(
+        cornerFabric(), cape::CapeSettings(),
+        btTransform(btQuaternion::getIdentity(), at + btVector3(-0.3f, 0.06f, 0.15f))));
     capes.back()->attach(0, bodies.back(), btVector3(-0.3f, 0.06f, 0.15f));
     capes.back()->attach(19, bodies.back(), btVector3(0.3f, 0.06f, 0.15f));
     group.add(capes.back().get());
@@ -34,8 +37,10 @@ std::vector<cape::Points> runGroup(int threads) {
   for (int frame = 1; frame <= 60; ++frame) {
     const double t = frame / 60.0;
     for (int k = 0; k < 3; ++k)
-      World::moveKinematic(bodies[std::size_t(k)], btTransform(btQuaternion(btVector3(0, 1, 0), btScalar(0.8 * t * (k + 1))),
-                                                   btVector3(btScalar(2 * k), btScalar(1.5 + 0.03 * std::sin(12.0 * t)), btScalar(-1.4 * t))));
+      World::moveKinematic(bodies[std::size_t(k)],
+                           btTransform(btQuaternion(btVector3(0, 1, 0), btScalar(0.8 * t * (k + 1))),
+                                       btVector3(btScalar(2 * k), btScalar(1.5 + 0.03 * std::sin(12.0 * t)),
+                                                 btScalar(-1.4 * t))));
     w.world->stepSimulation(kFrame, 8, kFixed);
   }
   w.world->removeAction(&group);
@@ -52,8 +57,10 @@ TEST(CapeGroup, OneAndTwoThreadsGiveIdenticalBits) {
   for (std::size_t k = 0; k < one.size(); ++k) {
     ASSERT_TRUE(one[k].allFinite());
     ASSERT_EQ(one[k].size(), two[k].size());
-    EXPECT_EQ(0, std::memcmp(one[k].data(), two[k].data(), sizeof(float) * std::size_t(one[k].size()))) << "cape " << k;
-    EXPECT_EQ(0, std::memcmp(one[k].data(), three[k].data(), sizeof(float) * std::size_t(one[k].size()))) << "cape " << k;
+    EXPECT_EQ(0, std::memcmp(one[k].data(), two[k].data(), sizeof(float) * std::size_t(one[k].size())))
+        << "cape " << k;
+    EXPECT_EQ(0, std::memcmp(one[k].data(), three[k].data(), sizeof(float) * std::size_t(one[k].size())))
+        << "cape " << k;
   }
   // The capes differ from one another (each body turns at its own rate): the comparison is not vacuous.
   EXPECT_GT((one[0].rowwise() - one[0].row(0)).norm(), 0.0f);
@@ -62,15 +69,18 @@ TEST(CapeGroup, OneAndTwoThreadsGiveIdenticalBits) {
 TEST(CapeGroup, SameResultAsTheCapeAddedAlone) {
   auto run = [](bool grouped) {
     World w;
-    btRigidBody* body = w.addKinematic(new btSphereShape(0.05f), btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
-    CapeAction action(cornerFabric(), cape::CapeSettings(), btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f)));
+    btRigidBody* body = w.addKinematic(new btSphereShape(0.05f),
+                                       btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+    CapeAction action(cornerFabric(), cape::CapeSettings(),
+                      btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f)));
     action.attachRow(0, body);
     cape::bullet::CapeGroup group(2);
     group.add(&action);
     btActionInterface* added = grouped ? static_cast<btActionInterface*>(&group) : &action;
     w.world->addAction(added);
     for (int frame = 1; frame <= 30; ++frame) {
-      World::moveKinematic(body, btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, -0.02f * frame)));
+      World::moveKinematic(body,
+                           btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, -0.02f * frame)));
       w.world->stepSimulation(kFrame, 8, kFixed);
     }
     w.world->removeAction(added);
@@ -82,9 +92,11 @@ TEST(CapeGroup, SameResultAsTheCapeAddedAlone) {
 
 TEST(SoftBodyTwin, SameNodesMassesLinksAndAnchorsAsTheCape) {
   World w(true);
-  btRigidBody* body = w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)), btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+  btRigidBody* body = w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)),
+                                     btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
   w.addStatic(new btSphereShape(0.2f), btTransform(btQuaternion::getIdentity(), btVector3(0, 0.8f, 0.4f)));
-  CapeAction action(cornerFabric(), cape::CapeSettings(), btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.56f, 0.15f)));
+  CapeAction action(cornerFabric(), cape::CapeSettings(),
+                    btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.56f, 0.15f)));
   action.attach(0, body, btVector3(-0.3f, 0.06f, 0.15f));
   action.attach(19, body, btVector3(0.3f, 0.06f, 0.15f));
   const cape::Fabric& fabric = action.cape().fabric();
@@ -106,7 +118,8 @@ TEST(SoftBodyTwin, SameNodesMassesLinksAndAnchorsAsTheCape) {
   EXPECT_EQ(full->m_links.size(), int(fabric.springCount()));
   w.soft()->removeSoftBody(full.get());
 
-  // It steps in the soft-rigid world next to the cape: anchored nodes follow the kinematic body, nothing blows up.
+  // It steps in the soft-rigid world next to the cape: anchored nodes follow the kinematic body, nothing
+  // blows up.
   w.world->addAction(&action);
   for (int frame = 1; frame <= 60; ++frame) {
     World::moveKinematic(body, btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, -0.02f * frame)));

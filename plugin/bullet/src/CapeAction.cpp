@@ -24,8 +24,8 @@ namespace cape::bullet {
 namespace {
 
 bool sameTransform(const btTransform& a, const btTransform& b) {
-  return a.getOrigin() == b.getOrigin() && a.getBasis()[0] == b.getBasis()[0] && a.getBasis()[1] == b.getBasis()[1] &&
-         a.getBasis()[2] == b.getBasis()[2];
+  return a.getOrigin() == b.getOrigin() && a.getBasis()[0] == b.getBasis()[0] &&
+         a.getBasis()[1] == b.getBasis()[1] && a.getBasis()[2] == b.getBasis()[2];
 }
 
 /// Angle of the rotation taking a's basis to b's, rad.
@@ -335,8 +335,8 @@ void CapeAction::applyInertia() {
   btQuaternion dq = t->stepEnd.getRotation() * t->stepStart.getRotation().inverse();
   if (dq.w() < 0) dq = -dq;
   const btQuaternion partial = btQuaternion::getIdentity().slerp(dq, btScalar(1) - ai);
-  const Quat r(static_cast<float>(partial.w()), static_cast<float>(partial.x()), static_cast<float>(partial.y()),
-               static_cast<float>(partial.z()));
+  const Quat r(static_cast<float>(partial.w()), static_cast<float>(partial.x()),
+               static_cast<float>(partial.y()), static_cast<float>(partial.z()));
   const Eigen::Matrix3f m = r.normalized().toRotationMatrix();
   const Vec3 centre = toVec3(c0);
   const Vec3 shift = toVec3((btScalar(1) - li) * (c1 - c0));
@@ -392,8 +392,10 @@ void CapeAction::buildColliders() {
       }
       colliders_.push_back(std::move(c));
     }
-    for (const ShapeConversion::Special& s : t.shape.convex) convexParts_.push_back({s.shape, t.stepEnd * s.local});
-    for (const ShapeConversion::Special& s : t.shape.concave) concaveParts_.push_back({s.shape, t.stepEnd * s.local});
+    for (const ShapeConversion::Special& s : t.shape.convex)
+      convexParts_.push_back({s.shape, t.stepEnd * s.local});
+    for (const ShapeConversion::Special& s : t.shape.concave)
+      concaveParts_.push_back({s.shape, t.stepEnd * s.local});
   }
 }
 
@@ -407,7 +409,8 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   updatePins();
   applyInertia();  // after the pins have their new targets: it shifts where they start
   buildColliders();
-  prepareMicroseconds_ = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  prepareMicroseconds_ =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
 }
 
 void CapeAction::advance(btScalar dt) {
@@ -420,7 +423,8 @@ void CapeAction::advance(btScalar dt) {
   if (!concaveParts_.empty()) concavePass(dt);
   ++stepCount_;
   lastStepMicroseconds_ =
-      prepareMicroseconds_ + std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+      prepareMicroseconds_ +
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   prepareMicroseconds_ = 0.0;
   accumulatedMicroseconds_ += lastStepMicroseconds_;
 }

@@ -20,13 +20,17 @@ CapeGroup::~CapeGroup() {
 }
 
 void CapeGroup::add(CapeAction* cape) {
-  if (cape != nullptr && std::find(capes_.begin(), capes_.end(), cape) == capes_.end()) capes_.push_back(cape);
+  if (cape != nullptr && std::find(capes_.begin(), capes_.end(), cape) == capes_.end())
+    capes_.push_back(cape);
 }
 
-void CapeGroup::remove(CapeAction* cape) { capes_.erase(std::remove(capes_.begin(), capes_.end(), cape), capes_.end()); }
+void CapeGroup::remove(CapeAction* cape) {
+  capes_.erase(std::remove(capes_.begin(), capes_.end(), cape), capes_.end());
+}
 
 void CapeGroup::work(int worker) {
-  for (std::size_t i = static_cast<std::size_t>(worker); i < capes_.size(); i += static_cast<std::size_t>(threadCount_))
+  for (std::size_t i = static_cast<std::size_t>(worker); i < capes_.size();
+       i += static_cast<std::size_t>(threadCount_))
     capes_[i]->advance(dt_);
 }
 
@@ -65,7 +69,8 @@ void CapeGroup::updateAction(btCollisionWorld* world, btScalar dt) {
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [&] { return pending_ == 0; });
   }
-  lastStepMicroseconds_ = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  lastStepMicroseconds_ =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
 }
 
 void CapeGroup::debugDraw(btIDebugDraw* drawer) {

@@ -52,28 +52,31 @@ void convertInto(ShapeConversion& out, const btCollisionShape* shape, const btTr
     case CAPSULE_SHAPE_PROXYTYPE: {
       // Radius and half height (half the distance between the sphere centres) are the scaled ones.
       const auto* c = static_cast<const btCapsuleShape*>(shape);
-      addPrimitive(out, Collider::capsule(float(c->getRadius()), float(c->getHalfHeight()), c->getUpAxis()), local,
-                   "btCapsuleShape");
+      addPrimitive(out, Collider::capsule(float(c->getRadius()), float(c->getHalfHeight()), c->getUpAxis()),
+                   local, "btCapsuleShape");
       return;
     }
     case CYLINDER_SHAPE_PROXYTYPE: {
       const auto* c = static_cast<const btCylinderShape*>(shape);
       const int axis = c->getUpAxis();
       const btVector3 h = c->getHalfExtentsWithMargin();
-      addPrimitive(out, Collider::cylinder(float(c->getRadius()), float(h[axis]), axis), local, "btCylinderShape");
+      addPrimitive(out, Collider::cylinder(float(c->getRadius()), float(h[axis]), axis), local,
+                   "btCylinderShape");
       return;
     }
     case MULTI_SPHERE_SHAPE_PROXYTYPE: {
       const auto* m = static_cast<const btMultiSphereShape*>(shape);
       const btVector3 scale = m->getLocalScaling();
-      const btScalar radiusScale = std::max({std::fabs(scale.x()), std::fabs(scale.y()), std::fabs(scale.z())});
+      const btScalar radiusScale =
+          std::max({std::fabs(scale.x()), std::fabs(scale.y()), std::fabs(scale.z())});
       for (int i = 0; i < m->getSphereCount(); ++i) {
         btTransform t = local;
         t.setOrigin(local * (m->getSpherePosition(i) * scale));
-        addPrimitive(out, Collider::sphere(float(m->getSphereRadius(i) * radiusScale)), t, "btMultiSphereShape");
+        addPrimitive(out, Collider::sphere(float(m->getSphereRadius(i) * radiusScale)), t,
+                     "btMultiSphereShape");
       }
-      // Bullet's multi-sphere is the convex hull of its spheres, not their union: the spheres are swept by the
-      // core (fast motion), and GJK keeps particles out of the hull between them after the step.
+      // Bullet's multi-sphere is the convex hull of its spheres, not their union: the spheres are swept by
+      // the core (fast motion), and GJK keeps particles out of the hull between them after the step.
       out.convex.push_back({shape, local});
       return;
     }
@@ -159,7 +162,8 @@ bool convexSignedDistance(const btConvexShape* shape, const btTransform& world, 
   return true;
 }
 
-btScalar shapeSignedDistance(const btCollisionShape* shape, const btTransform& world, const btVector3& point) {
+btScalar shapeSignedDistance(const btCollisionShape* shape, const btTransform& world,
+                             const btVector3& point) {
   constexpr btScalar kInf = std::numeric_limits<btScalar>::infinity();
   if (shape == nullptr) return kInf;
   const int type = shape->getShapeType();

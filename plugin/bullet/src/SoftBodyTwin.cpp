@@ -31,13 +31,14 @@ std::unique_ptr<btSoftBody> makeSoftBodyTwin(btSoftRigidDynamicsWorld& world, co
       // appendLink takes the rest length from the nodes' current distance; the fabric's rest length wins.
       body->appendLink(static_cast<int>(springs.first[s]), static_cast<int>(springs.second[s]), material);
       body->m_links[body->m_links.size() - 1].m_rl = btScalar(springs.restLength[s]);
-      body->m_links[body->m_links.size() - 1].m_c1 = body->m_links[body->m_links.size() - 1].m_rl *
-                                                      body->m_links[body->m_links.size() - 1].m_rl;
+      body->m_links[body->m_links.size() - 1].m_c1 =
+          body->m_links[body->m_links.size() - 1].m_rl * body->m_links[body->m_links.size() - 1].m_rl;
     }
   }
   const std::vector<std::uint32_t>& tri = fabric.triangles();
   for (std::size_t k = 0; k + 2 < tri.size(); k += 3)
-    body->appendFace(static_cast<int>(tri[k]), static_cast<int>(tri[k + 1]), static_cast<int>(tri[k + 2]), material);
+    body->appendFace(static_cast<int>(tri[k]), static_cast<int>(tri[k + 1]), static_cast<int>(tri[k + 2]),
+                     material);
 
   btSoftBody::Config& cfg = body->m_cfg;
   cfg.piterations = settings.positionIterations;
@@ -51,8 +52,8 @@ std::unique_ptr<btSoftBody> makeSoftBodyTwin(btSoftRigidDynamicsWorld& world, co
   body->getCollisionShape()->setMargin(settings.margin);
 
   for (const Attachment& a : cape.attachments()) {
-    // appendAnchor wants a mutable body; the anchor reads the body's transform and, for dynamic bodies, pushes
-    // on it (kinematic bodies make the anchor one-way, like the cape's pins).
+    // appendAnchor wants a mutable body; the anchor reads the body's transform and, for dynamic bodies,
+    // pushes on it (kinematic bodies make the anchor one-way, like the cape's pins).
     auto* rigid = const_cast<btRigidBody*>(a.body);
     body->appendAnchor(static_cast<int>(a.particle), rigid, a.localPivot, true, btScalar(1));
   }

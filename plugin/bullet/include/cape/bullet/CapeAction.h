@@ -14,9 +14,9 @@
 #include "cape/bullet/ShapeColliders.h"
 #include "cape/core/Cape.h"
 
+#include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
 #include <BulletDynamics/Dynamics/btActionInterface.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
-#include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
 
 #include <cstdint>
 #include <functional>
@@ -72,7 +72,8 @@ class CapeAction : public btActionInterface {
 
   /// A cape at the fabric's rest shape placed by `placement` (world = placement * rest), at rest.
   /// Check ok(): on bad fabric or settings the cape is empty and updates do nothing.
-  CapeAction(FabricPtr fabric, const CapeSettings& settings, const btTransform& placement = btTransform::getIdentity(),
+  CapeAction(FabricPtr fabric, const CapeSettings& settings,
+             const btTransform& placement = btTransform::getIdentity(),
              const CapeActionSettings& actionSettings = CapeActionSettings());
   ~CapeAction() override;
   CapeAction(const CapeAction&) = delete;
@@ -153,16 +154,16 @@ class CapeAction : public btActionInterface {
   /// A collision object the action follows: an attachment body, a collider, or both.
   struct Tracked {
     const btCollisionObject* object = nullptr;
-    btTransform lastSeen;       ///< Its world transform when last read.
-    btTransform segmentStart;   ///< The motion being spread over internal steps: from here...
-    btTransform segmentEnd;     ///< ...to here,
+    btTransform lastSeen;          ///< Its world transform when last read.
+    btTransform segmentStart;      ///< The motion being spread over internal steps: from here...
+    btTransform segmentEnd;        ///< ...to here,
     btScalar segmentDuration = 0;  ///< over this long, s (from the body's velocity; 0: at once).
     btScalar segmentElapsed = 0;   ///< s spent of it so far.
-    btTransform stepStart;      ///< Pose at the start of this internal step.
-    btTransform stepEnd;        ///< Pose at the end of this internal step.
-    bool jumped = false;        ///< Teleported in this step: no sweep.
+    btTransform stepStart;         ///< Pose at the start of this internal step.
+    btTransform stepEnd;           ///< Pose at the end of this internal step.
+    bool jumped = false;           ///< Teleported in this step: no sweep.
     bool explicitCollider = false;
-    bool discovered = false;    ///< Found by discovery for this step.
+    bool discovered = false;  ///< Found by discovery for this step.
     bool converted = false;
     ShapeConversion shape;
   };

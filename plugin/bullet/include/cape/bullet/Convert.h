@@ -11,7 +11,9 @@ namespace cape::bullet {
 inline Vec3 toVec3(const btVector3& v) {
   return Vec3(static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()));
 }
-inline btVector3 toBt(const Vec3& v) { return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z())); }
+inline btVector3 toBt(const Vec3& v) {
+  return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z()));
+}
 
 inline Pose toPose(const btTransform& t) {
   const btQuaternion q = t.getRotation();

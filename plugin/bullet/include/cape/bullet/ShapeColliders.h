@@ -27,9 +27,9 @@ struct ShapeConversion {
     const btCollisionShape* shape;  ///< btConvexShape (GJK) or btConcaveShape (triangles).
     btTransform local;
   };
-  std::vector<Primitive> primitives;  ///< Swept by the core.
-  std::vector<Special> convex;        ///< Through btGjkEpaSolver2::SignedDistance after the core step.
-  std::vector<Special> concave;       ///< Particle-triangle contacts after the core step.
+  std::vector<Primitive> primitives;     ///< Swept by the core.
+  std::vector<Special> convex;           ///< Through btGjkEpaSolver2::SignedDistance after the core step.
+  std::vector<Special> concave;          ///< Particle-triangle contacts after the core step.
   std::vector<std::string> unsupported;  ///< Names (btCollisionShape::getName) of shapes left out.
   bool empty() const { return primitives.empty() && convex.empty() && concave.empty(); }
 };
@@ -43,7 +43,8 @@ struct ShapeConversion {
 /// (exact for uniform scaling); a btStaticPlaneShape's scaling is ignored (a plane has no size).
 /// A btMultiSphereShape is the convex hull of its spheres: its spheres are core colliders and the shape
 /// also goes to the GJK pass, which keeps particles out of the hull between the spheres.
-ShapeConversion convertShape(const btCollisionShape* shape, const btTransform& local = btTransform::getIdentity());
+ShapeConversion convertShape(const btCollisionShape* shape,
+                             const btTransform& local = btTransform::getIdentity());
 
 /// Signed distance from a world point to a convex shape's true surface (margin included), m, negative
 /// inside, and the outward unit normal at the nearest surface point. Uses Bullet's GJK (outside and within

@@ -18,13 +18,13 @@ struct SoftBodyTwinSettings {
   bool structuralLinks = true;  ///< Rows and columns.
   bool shearLinks = true;       ///< Both diagonals of every cell.
   bool bendLinks = false;       ///< Every second particle along rows and columns (the fabric's bend family).
-  btScalar linearStiffness = btScalar(1);  ///< Material m_kLST, 0..1 (1: as stiff as the solver allows).
-  int positionIterations = 4;   ///< m_cfg.piterations.
-  int velocityIterations = 0;   ///< m_cfg.viterations.
-  int driftIterations = 0;      ///< m_cfg.diterations.
-  btScalar damping = btScalar(0.0);   ///< m_cfg.kDP, 0..1.
-  btScalar friction = btScalar(0.3);  ///< m_cfg.kDF, 0..1 (the cape's default friction).
-  btScalar anchorHardness = btScalar(1);  ///< m_cfg.kAHR, 0..1.
+  btScalar linearStiffness = btScalar(1);       ///< Material m_kLST, 0..1 (1: as stiff as the solver allows).
+  int positionIterations = 4;                   ///< m_cfg.piterations.
+  int velocityIterations = 0;                   ///< m_cfg.viterations.
+  int driftIterations = 0;                      ///< m_cfg.diterations.
+  btScalar damping = btScalar(0.0);             ///< m_cfg.kDP, 0..1.
+  btScalar friction = btScalar(0.3);            ///< m_cfg.kDF, 0..1 (the cape's default friction).
+  btScalar anchorHardness = btScalar(1);        ///< m_cfg.kAHR, 0..1.
   btScalar rigidContactHardness = btScalar(1);  ///< m_cfg.kCHR, 0..1.
   /// Collision margin of the soft body, m (the cape's thickness is a good value).
   btScalar margin = btScalar(0.01);
