@@ -453,6 +453,36 @@ TEST(CapeAction, ZeroInertiaCarriesTheCapeAlongWithItsBody) {
   EXPECT_GT(free, 0.05f);
 }
 
+TEST(CapeAction, ZeroAngularInertiaTurnsTheCapeWithItsBody) {
+  // The body spins a quarter turn about the vertical in 0.2 s: with no angular (and linear) inertia the
+  // cape turns with it as if rigid; with full inertia it swings out.
+  auto relative = [](btScalar inertia, bool turning) {
+    World w;
+    btRigidBody* body = w.addKinematic(new btSphereShape(0.05f),
+                                       btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+    cape::bullet::CapeActionSettings s;
+    s.linearInertia = s.angularInertia = inertia;
+    s.discoverColliders = false;
+    CapeAction action(cornerFabric(), cape::CapeSettings(),
+                      btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f)), s);
+    action.attachRow(0, body);
+    w.world->addAction(&action);
+    for (int frame = 0; frame < 60; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+    for (int frame = 1; frame <= 12; ++frame) {
+      const btScalar angle = turning ? SIMD_HALF_PI * btScalar(frame) / 12 : 0;
+      World::moveKinematic(body, btTransform(btQuaternion(btVector3(0, 1, 0), angle), btVector3(0, 1.5f, 0)));
+      w.world->stepSimulation(kFrame, 8, kFixed);
+    }
+    // In the body's frame.
+    const btVector3 r = body->getWorldTransform().invXform(action.position(19 * 20 + 10));
+    w.world->removeAction(&action);
+    return r;
+  };
+  const btVector3 still = relative(1, false);
+  EXPECT_LT((relative(0, true) - still).length(), 1e-3f);
+  EXPECT_GT((relative(1, true) - still).length(), 0.05f);
+}
+
 TEST(CapeAction, DebugDrawDrawsEveryTriangleEdge) {
   struct Counter : btIDebugDraw {
     int lines = 0;
