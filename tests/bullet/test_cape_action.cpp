@@ -76,6 +76,7 @@ TEST_P(PinStepping, PinsFollowATranslatingRotatingKinematicBodyAtEveryInternalSt
       worst = std::max(worst, double((probe.recorded[j][1] - expected * right).length()));
       ++steps;
     }
+    EXPECT_LT(action.maxPinError(), 1e-5f);
     tPrev = t;
   }
   EXPECT_GT(steps, 100);

@@ -98,6 +98,17 @@ btVector3 CapeAction::position(std::uint32_t particle) const {
   return toBt(Vec3(positions().row(particle).transpose()));
 }
 
+btScalar CapeAction::maxPinError() const {
+  btScalar worst = 0;
+  for (const Attachment& a : attachments_) {
+    auto it = trackedIndex_.find(a.body);
+    if (it == trackedIndex_.end()) continue;
+    const btVector3 target = tracked_[it->second].stepEnd * a.localPivot;
+    worst = std::max(worst, (position(a.particle) - target).length());
+  }
+  return worst;
+}
+
 double CapeAction::takeAccumulatedMicroseconds() {
   const double t = accumulatedMicroseconds_;
   accumulatedMicroseconds_ = 0.0;
