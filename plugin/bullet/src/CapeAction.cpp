@@ -230,13 +230,17 @@ void CapeAction::updateAction(btCollisionWorld* world, btScalar dt) {
 }
 
 void CapeAction::dropMissing(btCollisionWorld* world) {
-  // Pointers only: a body removed from the world may already be deleted.
-  worldObjects_.clear();
+  // Pointers only: a body removed from the world may already be deleted. One pass over the world's array
+  // marks the followed objects still in it (a lookup in the small map of followed objects, no allocation).
+  for (Tracked& t : tracked_) t.present = false;
   const btCollisionObjectArray& objects = world->getCollisionObjectArray();
-  for (int i = 0; i < objects.size(); ++i) worldObjects_.insert(objects[i]);
+  for (int i = 0; i < objects.size(); ++i) {
+    auto it = trackedIndex_.find(objects[i]);
+    if (it != trackedIndex_.end()) tracked_[it->second].present = true;
+  }
   bool dropped = false;
   for (const Tracked& t : tracked_) {
-    if (worldObjects_.count(t.object) != 0) continue;
+    if (t.present) continue;
     dropped = true;
     std::size_t released = 0;
     for (const Attachment& a : attachments_) released += a.body == t.object ? 1 : 0;
@@ -252,7 +256,7 @@ void CapeAction::dropMissing(btCollisionWorld* world) {
   std::vector<Tracked> kept;
   kept.reserve(tracked_.size());
   for (Tracked& t : tracked_)
-    if (worldObjects_.count(t.object) != 0) kept.push_back(std::move(t));
+    if (t.present) kept.push_back(std::move(t));
   tracked_ = std::move(kept);
   trackedIndex_.clear();
   for (std::size_t i = 0; i < tracked_.size(); ++i) trackedIndex_[tracked_[i].object] = i;

@@ -165,6 +165,7 @@ class CapeAction : public btActionInterface {
     btTransform stepStart;         ///< Pose at the start of this internal step.
     btTransform stepEnd;           ///< Pose at the end of this internal step.
     bool jumped = false;           ///< Teleported in this step: no sweep.
+    bool present = false;          ///< Still in the world at this update.
     bool explicitCollider = false;
     bool discovered = false;  ///< Found by discovery for this step.
     bool converted = false;
@@ -198,7 +199,6 @@ class CapeAction : public btActionInterface {
 
   std::vector<Tracked> tracked_;
   std::unordered_map<const btCollisionObject*, std::size_t> trackedIndex_;
-  std::unordered_set<const btCollisionObject*> worldObjects_;  ///< Scratch: pointers in the world.
 
   std::vector<Collider> colliders_;
   std::vector<const btCollisionObject*> activeObjects_;
