@@ -155,9 +155,9 @@ bool convexSignedDistance(const btConvexShape* shape, const btTransform& world, 
   if (!(d < std::numeric_limits<btScalar>::infinity()) || !std::isfinite(d)) return false;
   const btScalar len2 = r.normal.length2();
   if (!(len2 > btScalar(0.5)) || !std::isfinite(len2)) return false;
-  // GJK (outside the margin-less core) reports the distance to the surface with the margin; EPA (inside the
-  // core) reports the depth into the margin-less core, so the margin is added to it.
-  distance = r.status == btGjkEpaSolver2::sResults::Penetrating ? d - shape->getMargin() : d;
+  // Outside the margin-less core GJK gives the distance to the surface with its margin; inside it, EPA runs
+  // with the margins on (SignedDistance's default), so both are distances to the true surface.
+  distance = d;
   normal = r.normal;
   return true;
 }
