@@ -1,0 +1,444 @@
+#include "Renderer.h"
+
+#include "ShapeMesh.h"
+
+#include <GL/osmesa.h>
+#include <GL/gl.h>
+#include <png.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csetjmp>
+#include <cstdio>
+#include <cstdlib>
+
+namespace cape::demo {
+
+namespace fs = std::filesystem;
+
+// --- Camera -----------------------------------------------------------------------------------------------
+
+Camera Camera::lookAt(const Vec3& eye, const Vec3& target, int width, int height, float fovYDegrees, float zNear,
+                      float zFar) {
+  Camera c;
+  c.width = width;
+  c.height = height;
+  const Vec3 f = (target - eye).normalized();
+  const Vec3 s = f.cross(Vec3::UnitY()).normalized();
+  const Vec3 u = s.cross(f);
+  c.view.setIdentity();
+  c.view.block<1, 3>(0, 0) = s.transpose();
+  c.view.block<1, 3>(1, 0) = u.transpose();
+  c.view.block<1, 3>(2, 0) = -f.transpose();
+  c.view(0, 3) = -s.dot(eye);
+  c.view(1, 3) = -u.dot(eye);
+  c.view(2, 3) = f.dot(eye);
+  const float t = 1.0f / std::tan(0.5f * fovYDegrees * 3.14159265f / 180.0f);
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  c.projection.setZero();
+  c.projection(0, 0) = t / aspect;
+  c.projection(1, 1) = t;
+  c.projection(2, 2) = (zFar + zNear) / (zNear - zFar);
+  c.projection(2, 3) = 2.0f * zFar * zNear / (zNear - zFar);
+  c.projection(3, 2) = -1.0f;
+  return c;
+}
+
+bool Camera::project(const Vec3& world, Eigen::Vector2f& pixel) const {
+  const Vec4 clip = projection * view * Vec4(world.x(), world.y(), world.z(), 1.0f);
+  if (clip.w() <= 1e-6f) return false;
+  const float x = clip.x() / clip.w(), y = clip.y() / clip.w();
+  pixel = Eigen::Vector2f(0.5f * (x + 1.0f) * static_cast<float>(width), 0.5f * (1.0f - y) * static_cast<float>(height));
+  return true;
+}
+
+Vec3 Camera::eye() const {
+  const Eigen::Matrix3f r = view.block<3, 3>(0, 0);
+  return -(r.transpose() * view.block<3, 1>(0, 3));
+}
+
+// --- PNG --------------------------------------------------------------------------------------------------
+
+namespace {
+
+/// libpng's part, with only plain C locals around its setjmp.
+bool writePngFile(std::FILE* file, const std::uint8_t* rgba, int width, int height, int compression) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  if (!info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_init_io(png, file);
+  png_set_compression_level(png, compression);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  png_set_filler(png, 0, PNG_FILLER_AFTER);  // the rows are RGBA: drop the fourth byte
+  for (int y = 0; y < height; ++y) png_write_row(png, rgba + static_cast<std::size_t>(y) * static_cast<std::size_t>(width) * 4);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+}  // namespace
+
+bool writePng(const fs::path& file, const Image& image, std::string& error, int compression) {
+  std::FILE* f = std::fopen(file.c_str(), "wb");
+  if (!f) {
+    error = "cannot write " + file.string();
+    return false;
+  }
+  const bool ok = writePngFile(f, image.rgba.data(), image.width, image.height, std::clamp(compression, 0, 9));
+  if (std::fclose(f) != 0 || !ok) {
+    error = "cannot write PNG " + file.string();
+    return false;
+  }
+  return true;
+}
+
+// --- Renderer ---------------------------------------------------------------------------------------------
+
+namespace {
+
+void setMaterial(GLenum face, const Colour& c) {
+  const GLfloat diffuse[4] = {c.x(), c.y(), c.z(), 1.0f};
+  const GLfloat specular[4] = {0.08f, 0.08f, 0.08f, 1.0f};
+  glMaterialfv(face, GL_AMBIENT_AND_DIFFUSE, diffuse);
+  glMaterialfv(face, GL_SPECULAR, specular);
+  glMaterialf(face, GL_SHININESS, 24.0f);
+}
+
+void drawInterleaved(const std::vector<float>& vertices, const std::vector<std::uint32_t>& indices) {
+  glEnableClientState(GL_VERTEX_ARRAY);
+  glEnableClientState(GL_NORMAL_ARRAY);
+  glVertexPointer(3, GL_FLOAT, 6 * sizeof(float), vertices.data());
+  glNormalPointer(GL_FLOAT, 6 * sizeof(float), vertices.data() + 3);
+  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, indices.data());
+  glDisableClientState(GL_NORMAL_ARRAY);
+  glDisableClientState(GL_VERTEX_ARRAY);
+}
+
+}  // namespace
+
+Renderer::Renderer(int width, int height, int supersample)
+    : width_(width), height_(height), supersample_(std::clamp(supersample, 1, 4)) {
+  if (width < 16 || height < 16 || width > 4096 || height > 4096) {
+    error_ = "image size " + std::to_string(width) + "x" + std::to_string(height) + " outside 16..4096";
+    return;
+  }
+  const GLint attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 0,
+                              OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_COMPAT_PROFILE, 0};
+  OSMesaContext context = OSMesaCreateContextAttribs(attributes, nullptr);
+  if (!context) context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
+  if (!context) {
+    error_ = "cannot create an OSMesa OpenGL context";
+    return;
+  }
+  context_ = context;
+  buffer_.resize(static_cast<std::size_t>(width_ * supersample_) * static_cast<std::size_t>(height_ * supersample_) * 4);
+  if (!OSMesaMakeCurrent(context, buffer_.data(), GL_UNSIGNED_BYTE, width_ * supersample_, height_ * supersample_)) {
+    error_ = "cannot make the OSMesa context current";
+    return;
+  }
+  image_.width = width_;
+  image_.height = height_;
+  image_.rgba.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
+}
+
+Renderer::~Renderer() {
+  if (context_) OSMesaDestroyContext(static_cast<OSMesaContext>(context_));
+}
+
+void Renderer::begin(const Camera& camera, const Colour& background, bool lighting) {
+  if (!ok()) return;
+  OSMesaMakeCurrent(static_cast<OSMesaContext>(context_), buffer_.data(), GL_UNSIGNED_BYTE, width_ * supersample_,
+                    height_ * supersample_);
+  lighting_ = lighting;
+  glViewport(0, 0, width_ * supersample_, height_ * supersample_);
+  glClearColor(background.x(), background.y(), background.z(), 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  glDisable(GL_CULL_FACE);
+  glShadeModel(GL_SMOOTH);
+  glMatrixMode(GL_PROJECTION);
+  glLoadMatrixf(camera.projection.data());
+  glMatrixMode(GL_MODELVIEW);
+  glLoadMatrixf(camera.view.data());
+
+  // A key light from above and behind the camera's left, a weaker fill from the other side; directions in
+  // the world (set with the view loaded). Both sides of the cape are lit (two-sided lighting).
+  const GLfloat key[4] = {-0.45f, 0.85f, 0.55f, 0.0f}, fill[4] = {0.6f, 0.35f, -0.5f, 0.0f};
+  const GLfloat keyColour[4] = {0.75f, 0.73f, 0.70f, 1.0f}, fillColour[4] = {0.30f, 0.32f, 0.36f, 1.0f};
+  const GLfloat ambient[4] = {0.28f, 0.28f, 0.30f, 1.0f}, black[4] = {0, 0, 0, 1};
+  glLightfv(GL_LIGHT0, GL_POSITION, key);
+  glLightfv(GL_LIGHT0, GL_DIFFUSE, keyColour);
+  glLightfv(GL_LIGHT0, GL_SPECULAR, keyColour);
+  glLightfv(GL_LIGHT0, GL_AMBIENT, black);
+  glLightfv(GL_LIGHT1, GL_POSITION, fill);
+  glLightfv(GL_LIGHT1, GL_DIFFUSE, fillColour);
+  glLightfv(GL_LIGHT1, GL_SPECULAR, black);
+  glLightfv(GL_LIGHT1, GL_AMBIENT, black);
+  glLightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
+  glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
+  glEnable(GL_LIGHT0);
+  glEnable(GL_LIGHT1);
+  glDisable(GL_LIGHTING);
+}
+
+void Renderer::drawGround(const Vec3& centre, float halfSize) {
+  if (!ok()) return;
+  glDisable(GL_LIGHTING);
+  const float x0 = std::floor(centre.x() - halfSize), x1 = std::ceil(centre.x() + halfSize);
+  const float z0 = std::floor(centre.z() - halfSize), z1 = std::ceil(centre.z() + halfSize);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(1.0f, 1.0f);
+  glColor3f(0.78f, 0.78f, 0.76f);
+  glBegin(GL_QUADS);
+  glVertex3f(x0, 0, z0);
+  glVertex3f(x0, 0, z1);
+  glVertex3f(x1, 0, z1);
+  glVertex3f(x1, 0, z0);
+  glEnd();
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  glLineWidth(static_cast<float>(supersample_));
+  glBegin(GL_LINES);
+  for (float x = x0; x <= x1; x += 1.0f) {
+    const bool major = std::fmod(std::abs(x), 5.0f) < 0.5f;
+    glColor3f(major ? 0.45f : 0.62f, major ? 0.45f : 0.62f, major ? 0.47f : 0.62f);
+    glVertex3f(x, 0, z0);
+    glVertex3f(x, 0, z1);
+  }
+  for (float z = z0; z <= z1; z += 1.0f) {
+    const bool major = std::fmod(std::abs(z), 5.0f) < 0.5f;
+    glColor3f(major ? 0.45f : 0.62f, major ? 0.45f : 0.62f, major ? 0.47f : 0.62f);
+    glVertex3f(x0, 0, z);
+    glVertex3f(x1, 0, z);
+  }
+  glEnd();
+  glLineWidth(1.0f);
+}
+
+const Renderer::GpuMesh& Renderer::shapeMesh(const Collider& c) {
+  char key[160];
+  std::snprintf(key, sizeof(key), "%d %.5g %.5g %d %.5g %.5g %.5g", static_cast<int>(c.shape), c.radius, c.halfHeight,
+                c.axis, c.halfExtents.x(), c.halfExtents.y(), c.halfExtents.z());
+  auto it = shapes_.find(key);
+  if (it != shapes_.end()) return it->second;
+  const ShapeMesh shape = colliderMesh(c, 32);
+  GpuMesh mesh;
+  mesh.indices = shape.indices;
+  mesh.interleaved.reserve(shape.positions.size() * 2);
+  for (std::size_t i = 0; i < shape.vertexCount(); ++i) {
+    mesh.interleaved.insert(mesh.interleaved.end(), shape.positions.begin() + static_cast<long>(3 * i),
+                            shape.positions.begin() + static_cast<long>(3 * i + 3));
+    mesh.interleaved.insert(mesh.interleaved.end(), shape.normals.begin() + static_cast<long>(3 * i),
+                            shape.normals.begin() + static_cast<long>(3 * i + 3));
+  }
+  return shapes_.emplace(key, std::move(mesh)).first->second;
+}
+
+void Renderer::drawColliders(const std::vector<Collider>& colliders, const Colour& colour) {
+  if (!ok()) return;
+  if (lighting_) {
+    glEnable(GL_LIGHTING);
+    setMaterial(GL_FRONT_AND_BACK, colour);
+  } else {
+    glDisable(GL_LIGHTING);
+    glColor3f(colour.x(), colour.y(), colour.z());
+  }
+  for (const Collider& c : colliders) {
+    if (c.shape == ColliderShape::Plane) continue;
+    const GpuMesh& mesh = shapeMesh(c);
+    Eigen::Affine3f pose = Eigen::Translation3f(c.current.position) * c.current.rotation.normalized();
+    glPushMatrix();
+    glMultMatrixf(pose.matrix().data());
+    drawInterleaved(mesh.interleaved, mesh.indices);
+    glPopMatrix();
+  }
+  glDisable(GL_LIGHTING);
+}
+
+void Renderer::drawCape(const Cape& cape, const Colour& outside, const Colour& lining) {
+  if (!ok() || cape.fabric().particleCount() == 0) return;
+  if (capeFabric_ != &cape.fabric() || capeMesh_.positions.rows() != static_cast<Eigen::Index>(cape.fabric().particleCount())) {
+    capeMesh_.allocate(cape.fabric(), false);
+    capeFabric_ = &cape.fabric();
+  }
+  capeMesh_.update(cape.fabric(), cape.state().positions);
+  const auto n = static_cast<std::size_t>(capeMesh_.positions.rows());
+  capeVertices_.resize(6 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    for (int c = 0; c < 3; ++c) {
+      capeVertices_[6 * i + static_cast<std::size_t>(c)] = capeMesh_.positions(r, c);
+      capeVertices_[6 * i + 3 + static_cast<std::size_t>(c)] = capeMesh_.normals(r, c);
+    }
+  }
+  if (lighting_) {
+    glEnable(GL_LIGHTING);
+    setMaterial(GL_FRONT, outside);
+    setMaterial(GL_BACK, lining);
+  } else {
+    glDisable(GL_LIGHTING);
+    glColor3f(outside.x(), outside.y(), outside.z());
+  }
+  drawInterleaved(capeVertices_, capeMesh_.indices);
+  glDisable(GL_LIGHTING);
+}
+
+const Image& Renderer::finish() {
+  if (!ok()) return image_;
+  glFinish();
+  // Average supersample x supersample blocks; the GL buffer's rows run from the bottom.
+  const int s = supersample_, bw = width_ * s, bh = height_ * s;
+  const int weight = s * s;
+  for (int y = 0; y < height_; ++y) {
+    std::uint8_t* out = image_.rgba.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) * 4;
+    const int by = bh - (y + 1) * s;  // first buffer row of this image row's block
+    for (int x = 0; x < width_; ++x) {
+      int sum[4] = {0, 0, 0, 0};
+      for (int dy = 0; dy < s; ++dy) {
+        const std::uint8_t* in = buffer_.data() + (static_cast<std::size_t>(by + dy) * static_cast<std::size_t>(bw) + static_cast<std::size_t>(x * s)) * 4;
+        for (int dx = 0; dx < s; ++dx, in += 4) {
+          sum[0] += in[0];
+          sum[1] += in[1];
+          sum[2] += in[2];
+          sum[3] += in[3];
+        }
+      }
+      for (int c = 0; c < 4; ++c) out[4 * x + c] = static_cast<std::uint8_t>((sum[c] + weight / 2) / weight);
+    }
+  }
+  return image_;
+}
+
+// --- RunRenderer ------------------------------------------------------------------------------------------
+
+std::string shellQuote(const std::string& text) {
+  std::string q = "'";
+  for (char ch : text) {
+    if (ch == '\'') {
+      q += "'\\''";
+    } else {
+      q += ch;
+    }
+  }
+  return q + "'";
+}
+
+RunRenderer::RunRenderer(const fs::path& dir, int characters, int width, int height)
+    : dir_(dir), characters_(std::max(characters, 1)), pending_(static_cast<std::size_t>(characters_)) {
+  std::error_code ec;
+  fs::create_directories(dir_, ec);
+  if (ec || !fs::is_directory(dir_)) {
+    error_ = "cannot create render folder " + dir_.string() + (ec ? ": " + ec.message() : "");
+    return;
+  }
+  renderer_ = std::make_unique<Renderer>(width, height, 2);
+  if (!renderer_->ok()) error_ = renderer_->error();
+}
+
+void RunRenderer::record(int character, const Cape& cape, const std::vector<Collider>& colliders) {
+  if (!ok() || character < 0 || character >= characters_) return;
+  Pending& p = pending_[static_cast<std::size_t>(character)];
+  p.cape = &cape;
+  p.colliders.assign(colliders.begin(), colliders.end());
+  if (character == characters_ - 1) renderFrame();
+}
+
+void RunRenderer::renderFrame() {
+  const auto start = std::chrono::steady_clock::now();
+  // Where the characters are: the mean of their colliders' centres (the cape's, without colliders).
+  std::vector<Vec3> centres;
+  for (const Pending& p : pending_) {
+    if (!p.cape) continue;
+    Vec3 c = Vec3::Zero();
+    int count = 0;
+    for (const Collider& col : p.colliders) {
+      if (col.shape == ColliderShape::Plane) continue;
+      c += col.current.position;
+      ++count;
+    }
+    if (count == 0) {
+      c = p.cape->state().positions.colwise().mean().transpose();
+      count = 1;
+    }
+    centres.push_back(c / static_cast<float>(count));
+  }
+  Vec3 centre = Vec3::Zero();
+  for (const Vec3& c : centres) centre += c;
+  centre /= static_cast<float>(std::max<std::size_t>(centres.size(), 1));
+  float spread = 0.0f;
+  for (const Vec3& c : centres) spread = std::max(spread, (c - centre).norm());
+
+  // Turn with the heading of the motion (kept while standing), smoothed over about 0.35 s.
+  const float dt = 1.0f / 60.0f;
+  if (frame_ > 0) {
+    const Vec3 v = (centre - lastCentre_) / dt;
+    if (std::hypot(v.x(), v.z()) > 0.5f) {
+      const float target = std::atan2(-v.x(), -v.z());
+      float delta = std::remainder(target - heading_, 6.28318530718f);
+      heading_ += delta * (1.0f - std::exp(-dt / 0.35f));
+      heading_ = std::remainder(heading_, 6.28318530718f);
+    }
+  }
+  lastCentre_ = centre;
+  const Vec3 forward(-std::sin(heading_), 0.0f, -std::cos(heading_));
+  const Vec3 left(-std::cos(heading_), 0.0f, std::sin(heading_));
+  const Vec3 target(centre.x(), 1.05f, centre.z());
+  const Vec3 eye = target - (3.2f + 1.2f * spread) * forward + (1.7f + 0.6f * spread) * left + Vec3(0, 0.75f, 0);
+  camera_ = Camera::lookAt(eye, target, renderer_->width(), renderer_->height(), 40.0f);
+
+  renderer_->begin(camera_);
+  renderer_->drawGround(target, 40.0f);
+  for (const Pending& p : pending_) {
+    if (!p.cape) continue;
+    renderer_->drawColliders(p.colliders);
+    renderer_->drawCape(*p.cape);
+  }
+  const Image& image = renderer_->finish();
+  renderMs_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  ++frame_;
+  char name[32];
+  std::snprintf(name, sizeof(name), "%05d.png", frame_);
+  std::string error;
+  if (!writePng(dir_ / name, image, error, 3)) error_ = error;
+}
+
+bool RunRenderer::finish(std::string& error) {
+  if (!ok()) {
+    error = error_;
+    return false;
+  }
+  if (frame_ == 0) {
+    error = "no frames rendered into " + dir_.string();
+    return false;
+  }
+  if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0) {
+    std::printf("cape_walk: ffmpeg is not on PATH: no run.mp4 or run.gif; the frames are in %s\n", dir_.c_str());
+    return true;
+  }
+  const std::string frames = shellQuote((dir_ / "%05d.png").string());
+  const std::string mp4 = "ffmpeg -y -loglevel error -framerate 60 -i " + frames +
+                          " -c:v libx264 -pix_fmt yuv420p -crf 20 -preset medium -movflags +faststart " +
+                          shellQuote((dir_ / "run.mp4").string());
+  if (std::system(mp4.c_str()) != 0) {
+    error = "ffmpeg could not write " + (dir_ / "run.mp4").string();
+    return false;
+  }
+  const std::string gif = "ffmpeg -y -loglevel error -framerate 60 -i " + frames +
+                          " -vf \"fps=30,scale=320:-2:flags=lanczos,split[a][b];[a]palettegen=max_colors=96[p];"
+                          "[b][p]paletteuse=dither=bayer:bayer_scale=3\" " +
+                          shellQuote((dir_ / "run.gif").string());
+  if (std::system(gif.c_str()) != 0) {
+    error = "ffmpeg could not write " + (dir_ / "run.gif").string();
+    return false;
+  }
+  return true;
+}
+
+}  // namespace cape::demo

@@ -1,0 +1,142 @@
+// Headless pictures of a run through a real OpenGL implementation: Mesa's OSMesa (software, llvmpipe)
+// renders into memory; libpng writes the frames; ffmpeg, when on PATH, turns them into an MP4 and a GIF.
+// Legacy fixed-function GL is enough here: per-vertex lighting of the cape's area-weighted normals, lit on
+// both sides (GL_LIGHT_MODEL_TWO_SIDE: the back faces use the flipped normal and their own material).
+#pragma once
+
+#include "cape/core/Cape.h"
+#include "cape/core/CapeMesh.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace cape::demo {
+
+using Vec4 = Eigen::Vector4f;
+using Mat4 = Eigen::Matrix4f;
+
+/// A pinhole camera: view and projection matrices as OpenGL uses them, and the image they map to.
+struct Camera {
+  Mat4 view = Mat4::Identity();
+  Mat4 projection = Mat4::Identity();
+  int width = 640, height = 360;
+
+  /// Looks from `eye` at `target` with +Y up; vertical field of view in degrees; near and far in m.
+  static Camera lookAt(const Vec3& eye, const Vec3& target, int width, int height, float fovYDegrees = 40.0f,
+                       float zNear = 0.1f, float zFar = 200.0f);
+  /// Pixel coordinates of a world point (x to the right, y down from the top-left corner, pixel centres at
+  /// +0.5); false if it lies behind the camera.
+  bool project(const Vec3& world, Eigen::Vector2f& pixel) const;
+  Vec3 eye() const;
+};
+
+/// RGB colour, components in [0, 1].
+using Colour = Eigen::Vector3f;
+
+/// An RGBA8 image, rows from the top.
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;
+  const std::uint8_t* pixel(int x, int y) const { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
+};
+
+/// Writes RGB from an RGBA image as an 8-bit PNG (zlib level 0..9). False with a reason on failure.
+bool writePng(const std::filesystem::path& file, const Image& image, std::string& error, int compression = 6);
+
+/// One OSMesa context and its frame buffer. Draw calls go between begin() and finish().
+class Renderer {
+ public:
+  /// An image of width x height, rendered at `supersample` times the size in each direction and averaged
+  /// down (OSMesa has no multisampling). Check ok().
+  Renderer(int width, int height, int supersample = 2);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+  /// Clears to `background`, loads the camera and sets the lights; `lighting` false draws flat colours.
+  void begin(const Camera& camera, const Colour& background = Colour(0.80f, 0.86f, 0.93f), bool lighting = true);
+  /// The ground y = 0: a light plane with 1 m grid lines (darker every 5 m) within `halfSize` m of `centre`.
+  void drawGround(const Vec3& centre, float halfSize = 30.0f);
+  /// Colliders as their true shapes (planes are skipped: drawGround draws the ground).
+  void drawColliders(const std::vector<Collider>& colliders, const Colour& colour = Colour(0.50f, 0.60f, 0.75f));
+  /// The cape, smooth shaded with its per-vertex normals, `outside` on its front (counter-clockwise) faces
+  /// and `lining` on its back.
+  void drawCape(const Cape& cape, const Colour& outside = Colour(0.70f, 0.06f, 0.08f),
+                const Colour& lining = Colour(0.85f, 0.66f, 0.22f));
+  /// Finishes the frame and returns the image (valid until the next finish()).
+  const Image& finish();
+
+ private:
+  struct GpuMesh {
+    std::vector<float> interleaved;  ///< x, y, z, nx, ny, nz per vertex
+    std::vector<std::uint32_t> indices;
+  };
+  const GpuMesh& shapeMesh(const Collider& collider);
+
+  int width_, height_, supersample_;
+  std::string error_;
+  void* context_ = nullptr;           ///< OSMesaContext
+  std::vector<std::uint8_t> buffer_;  ///< The GL frame buffer, bottom row first, supersampled.
+  Image image_;
+  bool lighting_ = true;
+  CapeMesh capeMesh_;
+  const Fabric* capeFabric_ = nullptr;
+  std::vector<float> capeVertices_;   ///< Interleaved position and normal, refreshed per draw.
+  std::map<std::string, GpuMesh> shapes_;  ///< Collider meshes by shape and size.
+};
+
+/// Renders a run frame by frame into a folder: DIR/00001.png, ... and, with ffmpeg on PATH, DIR/run.mp4
+/// (H.264, 60 fps) and DIR/run.gif (30 fps, 320 px wide). The camera follows the characters from behind and
+/// to their left, looking at the torso, turning with their heading.
+class RunRenderer {
+ public:
+  /// Creates the folder. Check ok(): false with a reason if the folder or the GL context cannot be made.
+  RunRenderer(const std::filesystem::path& dir, int characters, int width = 640, int height = 360);
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+
+  /// Adds character k's cape and body colliders to the current frame; after the last character the frame is
+  /// rendered and written. Characters come in order 0, 1, ...
+  void record(int character, const Cape& cape, const std::vector<Collider>& colliders);
+  /// Runs ffmpeg for the video and the GIF (or says why not). False with a reason if a frame or the video
+  /// could not be written.
+  bool finish(std::string& error);
+
+  int frames() const { return frame_; }
+  /// Mean wall time per frame of drawing and reading back (PNG writing excluded), ms.
+  double meanRenderMs() const { return frame_ > 0 ? renderMs_ / frame_ : 0.0; }
+  /// The camera of the last frame.
+  const Camera& camera() const { return camera_; }
+
+ private:
+  void renderFrame();
+
+  std::filesystem::path dir_;
+  int characters_;
+  std::string error_;
+  std::unique_ptr<Renderer> renderer_;
+  struct Pending {
+    const Cape* cape = nullptr;
+    std::vector<Collider> colliders;
+  };
+  std::vector<Pending> pending_;
+  Camera camera_;
+  Vec3 lastCentre_ = Vec3::Zero();
+  float heading_ = 0.0f;  ///< rad about +Y; 0 faces -Z
+  int frame_ = 0;
+  double renderMs_ = 0.0;
+};
+
+/// Quotes a path for /bin/sh.
+std::string shellQuote(const std::string& text);
+
+}  // namespace cape::demo
