@@ -1,7 +1,9 @@
 // cape_walk: the headless walking demo. A character walks (or stands, sprints and turns, stands in the wind,
 // or walks in a crowd), its cape follows, and every metric of shared/SCENARIOS.md is written per frame.
 // `cape_walk --help` lists the options; with none it runs the walk scene into a fresh folder it names.
+#include "GltfExport.h"
 #include "Progress.h"
+#include "Renderer.h"
 #include "RunOutput.h"
 #include "SceneRun.h"
 
@@ -9,6 +11,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <map>
 
@@ -62,6 +65,10 @@ int main(int argc, char** argv) {
   app.add_flag("--simple-body", simpleBody, "use the simple body of SCENARIOS.md instead of a URDF character");
   app.add_option("--urdf", urdf, "character URDF file (default: the shipped humanoid)")->check(CLI::ExistingFile);
   app.add_option("--attach", attach, "comma-separated links the cape pins to (default: links named *shoulder*)");
+  std::string gltf, render, renderSize = "640x360";
+  app.add_option("--gltf", gltf, "also write the run as an animated glTF 2.0 binary (.glb)");
+  app.add_option("--render", render, "also render PNG frames (and run.mp4, run.gif with ffmpeg) into this folder");
+  app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   RunOptions o;
@@ -108,6 +115,25 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cape_walk: %s\n", e.what());
     return 1;
   }
+  std::unique_ptr<GltfRecorder> gltfRecorder;
+  std::unique_ptr<RunRenderer> renderer;
+  int renderWidth = 0, renderHeight = 0;
+  if (!gltf.empty() && !std::ofstream(gltf, std::ios::binary)) {
+    std::fprintf(stderr, "cape_walk: cannot write %s\n", gltf.c_str());
+    return 1;
+  }
+  if (!gltf.empty()) gltfRecorder = std::make_unique<GltfRecorder>(run->characterCount());
+  if (!render.empty()) {
+    if (std::sscanf(renderSize.c_str(), "%dx%d", &renderWidth, &renderHeight) != 2) {
+      std::fprintf(stderr, "cape_walk: --render-size %s is not WxH\n", renderSize.c_str());
+      return 1;
+    }
+    renderer = std::make_unique<RunRenderer>(render, run->characterCount(), renderWidth, renderHeight);
+    if (!renderer->ok()) {
+      std::fprintf(stderr, "cape_walk: %s\n", renderer->error().c_str());
+      return 1;
+    }
+  }
 
   std::vector<MetricsRecorder> recorders(static_cast<std::size_t>(run->characterCount()));
   std::vector<SelfIntersectionCounter> counters(recorders.size());
@@ -136,6 +162,8 @@ int main(int argc, char** argv) {
       row.metrics.meanSpeed = std::max(row.metrics.meanSpeed, m.meanSpeed);
       row.metrics.blowUp = row.metrics.blowUp || m.blowUp;
       writer->capeMesh(f, k, run->cape(k));
+      if (gltfRecorder) gltfRecorder->record(k, run->cape(k), colliders);
+      if (renderer) renderer->record(k, run->cape(k), colliders);
       for (Collider c : colliders) {
         if (run->characterCount() > 1) c.name = "k" + std::to_string(k) + "/" + c.name;
         allColliders.push_back(std::move(c));
@@ -148,6 +176,19 @@ int main(int argc, char** argv) {
     progress.update(f);
   }
   progress.finish();
+  if (gltfRecorder && !gltfRecorder->write(gltf, error)) {
+    std::fprintf(stderr, "cape_walk: %s\n", error.c_str());
+    return 1;
+  }
+  if (renderer && !renderer->finish(error)) {
+    std::fprintf(stderr, "cape_walk: %s\n", error.c_str());
+    return 1;
+  }
+  if (gltfRecorder) std::printf("cape_walk: glTF animation -> %s\n", gltf.c_str());
+  if (renderer) {
+    std::printf("cape_walk: %d frames rendered at %dx%d (%.1f ms each) -> %s\n", renderer->frames(), renderWidth,
+                renderHeight, renderer->meanRenderMs(), render.c_str());
+  }
 
   // Summary: per character and, for the table, the worst character.
   MetricsRecorder worst;
