@@ -15,7 +15,7 @@
 namespace cape::test {
 
 /// Settings with nothing acting but what a test switches on: no gravity, no damping, no skin, no
-/// friction, one substep of 1/60 s, no tethers.
+/// friction, one substep of 1/60 s (never refined), no tethers.
 inline CapeSettings quietSettings() {
   CapeSettings s;
   s.gravity = Vec3::Zero();
@@ -26,6 +26,7 @@ inline CapeSettings quietSettings() {
   s.iterations = 1;
   s.useTethers = false;
   s.timeStep = 1.0f / 60.0f;
+  s.strainLimit = 0.0f;
   return s;
 }
 

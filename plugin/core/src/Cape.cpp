@@ -173,6 +173,7 @@ void Cape::step(float dt, ColliderSpan colliders) {
   // timeStep at exactly `substeps` despite rounding).
   const float targetSubstep = settings_.timeStep / static_cast<float>(settings_.substeps);
   int substeps = std::max(1, static_cast<int>(std::ceil(dt / targetSubstep - 1e-3f)));
+  if (settings_.integrator == Integrator::Xpbd) substeps *= refinement_;
   if (settings_.integrator == Integrator::ExplicitSpring) {
     // A longer step than the settings were checked for: split it further rather than blow up.
     const float hMax = explicitStableStep(*fabric_, settings_);
@@ -188,7 +189,6 @@ void Cape::step(float dt, ColliderSpan colliders) {
     windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt), airVelocity_);
   // Self-contacts are found once per step, from where the cape is now, and kept through its substeps.
   if (settings_.selfCollision && settings_.integrator == Integrator::Xpbd) findSelfContacts(dt);
-  // Self-contacts are found once per step, from where the cape is now, and kept through its substeps.
   for (int k = 0; k < substeps; ++k) {
     const float s0 = static_cast<float>(k) / static_cast<float>(substeps);
     const float s1 = static_cast<float>(k + 1) / static_cast<float>(substeps);
@@ -199,6 +199,35 @@ void Cape::step(float dt, ColliderSpan colliders) {
   }
   for (Pin& p : state_.pins) p.previousTarget = p.target;
   state_.time += static_cast<double>(dt);
+  adaptRefinement();
+}
+
+void Cape::adaptRefinement() {
+  // Strain-adaptive substepping: one Gauss-Seidel pass per substep carries a sudden load (a 180-degree turn
+  // at a run) through a 20-row cape too slowly, and the cape stretches. When the structural strain after a
+  // step exceeds the limit, the next step takes twice the substeps (up to maxRefinement times); once it is
+  // below half the limit, half as many again. Decided from the state alone: deterministic.
+  const int maxRefinement = settings_.maxRefinement;
+  if (settings_.integrator != Integrator::Xpbd || !(settings_.strainLimit > 0.0f) || maxRefinement <= 1) {
+    refinement_ = 1;
+    return;
+  }
+  const SpringSet& set = fabric_->springs(SpringFamily::Structural);
+  const float* px = state_.positions.col(0).data();
+  const float* py = state_.positions.col(1).data();
+  const float* pz = state_.positions.col(2).data();
+  float worst = 0.0f;  // max over springs of |x_i - x_j|^2 / L0^2
+  for (std::size_t s = 0; s < set.size(); ++s) {
+    const std::uint32_t i = set.first[s], j = set.second[s];
+    const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
+    const float rest = set.restLength[s];
+    worst = std::max(worst, (dx * dx + dy * dy + dz * dz) / (rest * rest));
+  }
+  lastMaxStrain_ = std::sqrt(worst) - 1.0f;
+  if (lastMaxStrain_ > settings_.strainLimit)
+    refinement_ = std::min(2 * refinement_, maxRefinement);
+  else if (lastMaxStrain_ < 0.5f * settings_.strainLimit)
+    refinement_ = std::max(refinement_ / 2, 1);
 }
 
 void Cape::movePinsTo(float s, float h) {

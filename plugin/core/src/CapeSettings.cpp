@@ -51,6 +51,8 @@ Status CapeSettings::validate() const {
   if (selfCollision && !(std::isfinite(selfCollisionThickness) && selfCollisionThickness > 0.0f))
     return Status::error("CapeSettings: selfCollisionThickness must be finite and > 0 (m)");
   if (substeps < 1 || substeps > 1000) return Status::error("CapeSettings: substeps must be in 1..1000");
+  if (!(std::isfinite(strainLimit) && strainLimit >= 0.0f)) return Status::error("CapeSettings: strainLimit must be finite and >= 0");
+  if (maxRefinement < 1 || maxRefinement > 64) return Status::error("CapeSettings: maxRefinement must be in 1..64");
   if (iterations < 1 || iterations > 1000) return Status::error("CapeSettings: iterations must be in 1..1000");
   if (!gravity.allFinite()) return Status::error("CapeSettings: gravity must be finite");
   if (!(std::isfinite(timeStep) && timeStep > 0.0f)) return Status::error("CapeSettings: timeStep must be > 0 s");

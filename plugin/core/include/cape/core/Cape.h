@@ -64,6 +64,11 @@ class Cape {
     std::uint32_t collider;
   };
 
+  /// How many times the settings' substeps the next step takes (strain-adaptive substepping), and the max
+  /// structural strain measured after the last step.
+  int substepRefinement() const { return refinement_; }
+  float lastMaxStrain() const { return lastMaxStrain_; }
+
   /// Self-contacts found for the last step (diagnostics and benchmarks).
   std::size_t selfContactCount() const { return selfContacts_.size(); }
 
@@ -74,6 +79,7 @@ class Cape {
   void stepXpbd(float h, float s0, float s1, ColliderSpan colliders);
   void stepExplicit(float h, float s0, float s1, ColliderSpan colliders);
   void movePinsTo(float s, float h);
+  void adaptRefinement();
   void collide(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode);
   void reprojectContacts(ColliderSpan colliders);
   void prepareSpringDenominators(float h);
@@ -85,6 +91,8 @@ class Cape {
 
   FabricPtr fabric_;
   CapeSettings settings_;
+  int refinement_ = 1;          ///< Substep multiplier of the next step (1, 2, 4, ...).
+  float lastMaxStrain_ = 0.0f;  ///< Max structural strain after the last step.
   CapeState state_;
   Status status_ = Status::success();
 
