@@ -106,7 +106,7 @@ TEST_P(DropOnShape, ComesToRestOnItWithNoParticleDeeperThanOneMillimetre) {
   CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.5)));
   w.world->addAction(&action);
   double worstDepth = 0.0;
-  for (int frame = 0; frame < 100; ++frame) {
+  for (int frame = 0; frame < 80; ++frame) {
     w.world->stepSimulation(kFrame, 8, btScalar(c.fixed));
     for (std::size_t i = 0; i < action.particleCount(); ++i) {
       const btScalar d = cape::bullet::shapeSignedDistance(shape, body->getWorldTransform(),

@@ -13,14 +13,14 @@ using cape::bullet::CapeAction;
 
 namespace {
 
-/// Three capes pinned to three kinematic bodies that walk and turn, over a sphere each, stepped by a group
+/// Two capes pinned to two kinematic bodies that walk and turn, over a sphere each, stepped by a group
 /// of `threads`; returns every cape's final positions.
 std::vector<cape::Points> runGroup(int threads) {
   World w;
   std::vector<std::unique_ptr<CapeAction>> capes;
   std::vector<btRigidBody*> bodies;
   cape::bullet::CapeGroup group(threads);
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 2; ++k) {
     const btVector3 at(btScalar(2 * k), btScalar(1.5), 0);
     bodies.push_back(w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)),
                                     btTransform(btQuaternion::getIdentity(), at)));
@@ -34,9 +34,9 @@ std::vector<cape::Points> runGroup(int threads) {
     group.add(capes.back().get());
   }
   w.world->addAction(&group);
-  for (int frame = 1; frame <= 60; ++frame) {
+  for (int frame = 1; frame <= 40; ++frame) {
     const double t = frame / 60.0;
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < 2; ++k)
       World::moveKinematic(bodies[std::size_t(k)],
                            btTransform(btQuaternion(btVector3(0, 1, 0), btScalar(0.8 * t * (k + 1))),
                                        btVector3(btScalar(2 * k), btScalar(1.5 + 0.03 * std::sin(12.0 * t)),
@@ -52,18 +52,17 @@ std::vector<cape::Points> runGroup(int threads) {
 }  // namespace
 
 TEST(CapeGroup, OneAndTwoThreadsGiveIdenticalBits) {
-  const std::vector<cape::Points> one = runGroup(1), two = runGroup(2), three = runGroup(3);
-  ASSERT_EQ(one.size(), 3u);
+  const std::vector<cape::Points> one = runGroup(1), two = runGroup(2);
+  ASSERT_EQ(one.size(), 2u);
   for (std::size_t k = 0; k < one.size(); ++k) {
     ASSERT_TRUE(one[k].allFinite());
     ASSERT_EQ(one[k].size(), two[k].size());
     EXPECT_EQ(0, std::memcmp(one[k].data(), two[k].data(), sizeof(float) * std::size_t(one[k].size())))
         << "cape " << k;
-    EXPECT_EQ(0, std::memcmp(one[k].data(), three[k].data(), sizeof(float) * std::size_t(one[k].size())))
-        << "cape " << k;
   }
-  // The capes differ from one another (each body turns at its own rate): the comparison is not vacuous.
+  // Each body turns at its own rate, so the two capes differ: the comparison is not of two copies.
   EXPECT_GT((one[0].rowwise() - one[0].row(0)).norm(), 0.0f);
+  EXPECT_GT((one[0] - one[1]).cwiseAbs().maxCoeff(), 0.0f);
 }
 
 TEST(CapeGroup, SameResultAsTheCapeAddedAlone) {
