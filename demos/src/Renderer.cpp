@@ -111,12 +111,12 @@ void setMaterial(GLenum face, const Colour& c) {
   glMaterialf(face, GL_SHININESS, 24.0f);
 }
 
-void drawInterleaved(const std::vector<float>& vertices, const std::vector<std::uint32_t>& indices) {
+void drawInterleaved(const std::vector<float>& vertices, const std::uint32_t* indices, std::size_t count) {
   glEnableClientState(GL_VERTEX_ARRAY);
   glEnableClientState(GL_NORMAL_ARRAY);
   glVertexPointer(3, GL_FLOAT, 6 * sizeof(float), vertices.data());
   glNormalPointer(GL_FLOAT, 6 * sizeof(float), vertices.data() + 3);
-  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, indices.data());
+  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT, indices);
   glDisableClientState(GL_NORMAL_ARRAY);
   glDisableClientState(GL_VERTEX_ARRAY);
 }
@@ -187,6 +187,17 @@ void Renderer::begin(const Camera& camera, const Colour& background, bool lighti
   glEnable(GL_LIGHT0);
   glEnable(GL_LIGHT1);
   glDisable(GL_LIGHTING);
+  // Fog into the background hides the ground's edge and the grid's aliasing near the horizon.
+  const GLfloat fog[4] = {background.x(), background.y(), background.z(), 1.0f};
+  glFogi(GL_FOG_MODE, GL_LINEAR);
+  glFogfv(GL_FOG_COLOR, fog);
+  glFogf(GL_FOG_START, 12.0f);
+  glFogf(GL_FOG_END, 38.0f);
+  if (lighting) {
+    glEnable(GL_FOG);
+  } else {
+    glDisable(GL_FOG);
+  }
 }
 
 void Renderer::drawGround(const Vec3& centre, float halfSize) {
@@ -197,11 +208,16 @@ void Renderer::drawGround(const Vec3& centre, float halfSize) {
   glEnable(GL_POLYGON_OFFSET_FILL);
   glPolygonOffset(1.0f, 1.0f);
   glColor3f(0.78f, 0.78f, 0.76f);
+  // In 2 m tiles: the fixed-function fog is computed per vertex, so one big quad would be fogged all over.
   glBegin(GL_QUADS);
-  glVertex3f(x0, 0, z0);
-  glVertex3f(x0, 0, z1);
-  glVertex3f(x1, 0, z1);
-  glVertex3f(x1, 0, z0);
+  for (float x = x0; x < x1; x += 2.0f) {
+    for (float z = z0; z < z1; z += 2.0f) {
+      glVertex3f(x, 0, z);
+      glVertex3f(x, 0, z + 2.0f);
+      glVertex3f(x + 2.0f, 0, z + 2.0f);
+      glVertex3f(x + 2.0f, 0, z);
+    }
+  }
   glEnd();
   glDisable(GL_POLYGON_OFFSET_FILL);
   glLineWidth(static_cast<float>(supersample_));
@@ -209,14 +225,18 @@ void Renderer::drawGround(const Vec3& centre, float halfSize) {
   for (float x = x0; x <= x1; x += 1.0f) {
     const bool major = std::fmod(std::abs(x), 5.0f) < 0.5f;
     glColor3f(major ? 0.45f : 0.62f, major ? 0.45f : 0.62f, major ? 0.47f : 0.62f);
-    glVertex3f(x, 0, z0);
-    glVertex3f(x, 0, z1);
+    for (float z = z0; z < z1; z += 2.0f) {
+      glVertex3f(x, 0, z);
+      glVertex3f(x, 0, z + 2.0f);
+    }
   }
   for (float z = z0; z <= z1; z += 1.0f) {
     const bool major = std::fmod(std::abs(z), 5.0f) < 0.5f;
     glColor3f(major ? 0.45f : 0.62f, major ? 0.45f : 0.62f, major ? 0.47f : 0.62f);
-    glVertex3f(x0, 0, z);
-    glVertex3f(x1, 0, z);
+    for (float x = x0; x < x1; x += 2.0f) {
+      glVertex3f(x, 0, z);
+      glVertex3f(x + 2.0f, 0, z);
+    }
   }
   glEnd();
   glLineWidth(1.0f);
@@ -256,7 +276,7 @@ void Renderer::drawColliders(const std::vector<Collider>& colliders, const Colou
     Eigen::Affine3f pose = Eigen::Translation3f(c.current.position) * c.current.rotation.normalized();
     glPushMatrix();
     glMultMatrixf(pose.matrix().data());
-    drawInterleaved(mesh.interleaved, mesh.indices);
+    drawInterleaved(mesh.interleaved, mesh.indices.data(), mesh.indices.size());
     glPopMatrix();
   }
   glDisable(GL_LIGHTING);
@@ -269,13 +289,18 @@ void Renderer::drawCape(const Cape& cape, const Colour& outside, const Colour& l
     capeFabric_ = &cape.fabric();
   }
   capeMesh_.update(cape.fabric(), cape.state().positions);
-  const auto n = static_cast<std::size_t>(capeMesh_.positions.rows());
+  drawCape(capeMesh_, outside, lining);
+}
+
+void Renderer::drawCape(const CapeMesh& mesh, const Colour& outside, const Colour& lining) {
+  if (!ok() || mesh.positions.rows() == 0) return;
+  const auto n = static_cast<std::size_t>(mesh.positions.rows());
   capeVertices_.resize(6 * n);
   for (std::size_t i = 0; i < n; ++i) {
     const auto r = static_cast<Eigen::Index>(i);
     for (int c = 0; c < 3; ++c) {
-      capeVertices_[6 * i + static_cast<std::size_t>(c)] = capeMesh_.positions(r, c);
-      capeVertices_[6 * i + 3 + static_cast<std::size_t>(c)] = capeMesh_.normals(r, c);
+      capeVertices_[6 * i + static_cast<std::size_t>(c)] = mesh.positions(r, c);
+      capeVertices_[6 * i + 3 + static_cast<std::size_t>(c)] = mesh.normals(r, c);
     }
   }
   if (lighting_) {
@@ -286,7 +311,8 @@ void Renderer::drawCape(const Cape& cape, const Colour& outside, const Colour& l
     glDisable(GL_LIGHTING);
     glColor3f(outside.x(), outside.y(), outside.z());
   }
-  drawInterleaved(capeVertices_, capeMesh_.indices);
+  const std::size_t front = mesh.twoSided() ? mesh.indices.size() / 2 : mesh.indices.size();
+  drawInterleaved(capeVertices_, mesh.indices.data(), front);
   glDisable(GL_LIGHTING);
 }
 
@@ -346,6 +372,16 @@ void RunRenderer::record(int character, const Cape& cape, const std::vector<Coll
   if (!ok() || character < 0 || character >= characters_) return;
   Pending& p = pending_[static_cast<std::size_t>(character)];
   p.cape = &cape;
+  p.mesh = nullptr;
+  p.colliders.assign(colliders.begin(), colliders.end());
+  if (character == characters_ - 1) renderFrame();
+}
+
+void RunRenderer::record(int character, const CapeMesh& mesh, const std::vector<Collider>& colliders) {
+  if (!ok() || character < 0 || character >= characters_) return;
+  Pending& p = pending_[static_cast<std::size_t>(character)];
+  p.cape = nullptr;
+  p.mesh = &mesh;
   p.colliders.assign(colliders.begin(), colliders.end());
   if (character == characters_ - 1) renderFrame();
 }
@@ -355,7 +391,7 @@ void RunRenderer::renderFrame() {
   // Where the characters are: the mean of their colliders' centres (the cape's, without colliders).
   std::vector<Vec3> centres;
   for (const Pending& p : pending_) {
-    if (!p.cape) continue;
+    if (!p.cape && !p.mesh) continue;
     Vec3 c = Vec3::Zero();
     int count = 0;
     for (const Collider& col : p.colliders) {
@@ -364,7 +400,7 @@ void RunRenderer::renderFrame() {
       ++count;
     }
     if (count == 0) {
-      c = p.cape->state().positions.colwise().mean().transpose();
+      c = (p.cape ? p.cape->state().positions : p.mesh->positions).colwise().mean().transpose();
       count = 1;
     }
     centres.push_back(c / static_cast<float>(count));
@@ -389,16 +425,16 @@ void RunRenderer::renderFrame() {
   lastCentre_ = centre;
   const Vec3 forward(-std::sin(heading_), 0.0f, -std::cos(heading_));
   const Vec3 left(-std::cos(heading_), 0.0f, std::sin(heading_));
-  const Vec3 target(centre.x(), 1.05f, centre.z());
-  const Vec3 eye = target - (3.2f + 1.2f * spread) * forward + (1.7f + 0.6f * spread) * left + Vec3(0, 0.75f, 0);
+  const Vec3 target(centre.x(), 1.0f, centre.z());
+  const Vec3 eye = target - (2.8f + 1.2f * spread) * forward + (1.5f + 0.6f * spread) * left + Vec3(0, 0.6f, 0);
   camera_ = Camera::lookAt(eye, target, renderer_->width(), renderer_->height(), 40.0f);
 
   renderer_->begin(camera_);
   renderer_->drawGround(target, 40.0f);
   for (const Pending& p : pending_) {
-    if (!p.cape) continue;
     renderer_->drawColliders(p.colliders);
-    renderer_->drawCape(*p.cape);
+    if (p.cape) renderer_->drawCape(*p.cape);
+    if (p.mesh) renderer_->drawCape(*p.mesh);
   }
   const Image& image = renderer_->finish();
   renderMs_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

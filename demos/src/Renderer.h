@@ -72,6 +72,10 @@ class Renderer {
   /// and `lining` on its back.
   void drawCape(const Cape& cape, const Colour& outside = Colour(0.70f, 0.06f, 0.08f),
                 const Colour& lining = Colour(0.85f, 0.66f, 0.22f));
+  /// Any cloth given as a mesh (a btSoftBody's nodes and faces, say): its front triangles only when the mesh
+  /// is two-sided, since the lighting already shades both sides.
+  void drawCape(const CapeMesh& mesh, const Colour& outside = Colour(0.70f, 0.06f, 0.08f),
+                const Colour& lining = Colour(0.85f, 0.66f, 0.22f));
   /// Finishes the frame and returns the image (valid until the next finish()).
   const Image& finish();
 
@@ -107,6 +111,8 @@ class RunRenderer {
   /// Adds character k's cape and body colliders to the current frame; after the last character the frame is
   /// rendered and written. Characters come in order 0, 1, ...
   void record(int character, const Cape& cape, const std::vector<Collider>& colliders);
+  /// The same for a cloth given as a mesh (kept by the caller until the frame is rendered).
+  void record(int character, const CapeMesh& mesh, const std::vector<Collider>& colliders);
   /// Runs ffmpeg for the video and the GIF (or says why not). False with a reason if a frame or the video
   /// could not be written.
   bool finish(std::string& error);
@@ -126,6 +132,7 @@ class RunRenderer {
   std::unique_ptr<Renderer> renderer_;
   struct Pending {
     const Cape* cape = nullptr;
+    const CapeMesh* mesh = nullptr;
     std::vector<Collider> colliders;
   };
   std::vector<Pending> pending_;

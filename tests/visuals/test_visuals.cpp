@@ -216,6 +216,19 @@ TEST(Renderer, CapePixelsAreWhereItsVerticesProject) {
   for (auto [px, py] : {std::pair{0, 0}, std::pair{w - 1, 0}, std::pair{0, h - 1}, std::pair{w - 1, h - 1}}) {
     EXPECT_EQ(image.pixel(px, py)[0], 0);
   }
+
+  // A cloth handed over as a two-sided mesh (as a btSoftBody twin would be) draws the same picture, lit.
+  const std::vector<std::uint8_t> unlit = image.rgba;
+  renderer.begin(camera);
+  renderer.drawCape(scene.cape());
+  const std::vector<std::uint8_t> fromCape = renderer.finish().rgba;
+  CapeMesh mesh;
+  mesh.allocate(scene.cape().fabric(), true);
+  mesh.update(scene.cape().fabric(), scene.cape().state().positions);
+  renderer.begin(camera);
+  renderer.drawCape(mesh);
+  EXPECT_TRUE(renderer.finish().rgba == fromCape);
+  EXPECT_FALSE(fromCape == unlit);
 }
 
 TEST(RunRenderer, FramesHaveTheRequestedSizeAndAreNotBlank) {
