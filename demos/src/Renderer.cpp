@@ -149,7 +149,9 @@ Renderer::Renderer(int width, int height, int supersample)
 }
 
 Renderer::~Renderer() {
-  if (context_) OSMesaDestroyContext(static_cast<OSMesaContext>(context_));
+  if (!context_) return;
+  if (OSMesaGetCurrentContext() == static_cast<OSMesaContext>(context_)) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+  OSMesaDestroyContext(static_cast<OSMesaContext>(context_));
 }
 
 void Renderer::begin(const Camera& camera, const Colour& background, bool lighting) {
