@@ -1,6 +1,9 @@
 // Google Benchmark over the cape step in the canonical scenes of shared/SCENARIOS.md (simple body, no
 // Bullet), for N x N capes. One benchmark iteration is one 1/60 s frame: the body and pins move, then the
-// cape steps (4 substeps by default). Reported: time per frame and particles per second.
+// cape steps. BM_WalkFrame keeps the substeps fixed (3 per frame: the cost of the step itself, and how it
+// scales with N); BM_WalkFrameAdaptive uses the default strain-adaptive substepping, which refines larger
+// capes (more rows for one Gauss-Seidel pass to carry) to hold the strain under 5 %. Reported: time per frame
+// and particles per second.
 #include "cape/core/Scene.h"
 
 #include <benchmark/benchmark.h>
@@ -30,13 +33,21 @@ void runFrames(benchmark::State& state, SceneKind kind, const CapeSettings& sett
       benchmark::Counter(static_cast<double>(n) * n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
-void BM_WalkFrame(benchmark::State& state) { runFrames(state, SceneKind::Walk, CapeSettings()); }
-void BM_WalkFrame4Substeps(benchmark::State& state) {
+CapeSettings fixedSubsteps() {
   CapeSettings s;
+  s.strainLimit = 0.0f;
+  return s;
+}
+
+void BM_WalkFrame(benchmark::State& state) { runFrames(state, SceneKind::Walk, fixedSubsteps()); }
+void BM_WalkFrameAdaptive(benchmark::State& state) { runFrames(state, SceneKind::Walk, CapeSettings()); }
+void BM_WalkFrame4Substeps(benchmark::State& state) {
+  CapeSettings s = fixedSubsteps();
   s.substeps = 4;
   runFrames(state, SceneKind::Walk, s);
 }
 void BM_SprintTurnFrame(benchmark::State& state) { runFrames(state, SceneKind::SprintTurn, CapeSettings()); }
+void BM_SprintTurnFrameFixed(benchmark::State& state) { runFrames(state, SceneKind::SprintTurn, fixedSubsteps()); }
 void BM_WalkFrameSeedExplicit(benchmark::State& state) {
   CapeSettings s = CapeSettings::seed();
   s.timeStep = 1.0f / 60.0f;
@@ -47,7 +58,9 @@ void BM_WalkFrameSeedExplicit(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_WalkFrame)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WalkFrameAdaptive)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrame4Substeps)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SprintTurnFrame)->Arg(20)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SprintTurnFrameFixed)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrameSeedExplicit)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK_MAIN();
