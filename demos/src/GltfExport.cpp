@@ -18,9 +18,7 @@ namespace {
 /// Builds buffer views and accessors into the model's single buffer (the GLB's binary chunk).
 class BufferBuilder {
  public:
-  explicit BufferBuilder(tinygltf::Model& model) : model_(model) {
-    model_.buffers.resize(1);
-  }
+  explicit BufferBuilder(tinygltf::Model& model) : model_(model) { model_.buffers.resize(1); }
 
   /// Appends bytes as a new buffer view (4-byte aligned, as float and uint32 accessors need).
   int view(const void* data, std::size_t bytes, int target) {
@@ -64,8 +62,8 @@ class BufferBuilder {
   }
 
   int indices(const std::vector<std::uint32_t>& data) {
-    const int view = this->view(data.data(), data.size() * sizeof(std::uint32_t),
-                                TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    const int view =
+        this->view(data.data(), data.size() * sizeof(std::uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
     tinygltf::Accessor a;
     a.bufferView = view;
     a.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
@@ -113,14 +111,17 @@ int addNode(tinygltf::Model& model, tinygltf::Node node) {
 void copyRows(const Points& points, std::size_t rows, std::vector<float>& out) {
   out.resize(rows * 3);
   for (std::size_t i = 0; i < rows; ++i) {
-    for (int c = 0; c < 3; ++c) out[i * 3 + static_cast<std::size_t>(c)] = points(static_cast<Eigen::Index>(i), c);
+    for (int c = 0; c < 3; ++c)
+      out[i * 3 + static_cast<std::size_t>(c)] = points(static_cast<Eigen::Index>(i), c);
   }
 }
 
 }  // namespace
 
 GltfRecorder::GltfRecorder(int characters, double frameTime)
-    : characters_(std::max(characters, 1)), frameTime_(frameTime), tracks_(static_cast<std::size_t>(characters_)) {}
+    : characters_(std::max(characters, 1)),
+      frameTime_(frameTime),
+      tracks_(static_cast<std::size_t>(characters_)) {}
 
 void GltfRecorder::record(int character, const Cape& cape, const std::vector<Collider>& colliders) {
   if (character < 0 || character >= characters_) return;
@@ -205,8 +206,10 @@ bool GltfRecorder::write(const std::filesystem::path& file, std::string& error) 
   // The ground: 1 m checker tiles covering the colliders' path with 10 m to spare, two primitives.
   {
     const float margin = 10.0f;
-    const int x0 = static_cast<int>(std::floor(sceneMin_.x() - margin)), x1 = static_cast<int>(std::ceil(sceneMax_.x() + margin));
-    const int z0 = static_cast<int>(std::floor(sceneMin_.z() - margin)), z1 = static_cast<int>(std::ceil(sceneMax_.z() + margin));
+    const int x0 = static_cast<int>(std::floor(sceneMin_.x() - margin)),
+              x1 = static_cast<int>(std::ceil(sceneMax_.x() + margin));
+    const int z0 = static_cast<int>(std::floor(sceneMin_.z() - margin)),
+              z1 = static_cast<int>(std::ceil(sceneMax_.z() + margin));
     std::vector<float> pos[2], nrm[2];
     std::vector<std::uint32_t> idx[2];
     for (int x = x0; x < x1; ++x) {
@@ -223,7 +226,8 @@ bool GltfRecorder::write(const std::filesystem::path& file, std::string& error) 
     tinygltf::Mesh mesh;
     mesh.name = "ground";
     for (int k = 0; k < 2; ++k) {
-      if (!idx[k].empty()) mesh.primitives.push_back(primitive(b, pos[k], nrm[k], idx[k], k == 0 ? groundLight : groundDark));
+      if (!idx[k].empty())
+        mesh.primitives.push_back(primitive(b, pos[k], nrm[k], idx[k], k == 0 ? groundLight : groundDark));
     }
     model.meshes.push_back(std::move(mesh));
     tinygltf::Node node;
@@ -268,8 +272,11 @@ bool GltfRecorder::write(const std::filesystem::path& file, std::string& error) 
       group.children.push_back(id);
       // Frames a collider missed (it was recorded later than others) repeat its last pose.
       const std::size_t keys = times.size();
-      while (track.translations.size() < 3 * keys) track.translations.insert(track.translations.end(), track.translations.end() - 3, track.translations.end());
-      while (track.rotations.size() < 4 * keys) track.rotations.insert(track.rotations.end(), track.rotations.end() - 4, track.rotations.end());
+      while (track.translations.size() < 3 * keys)
+        track.translations.insert(track.translations.end(), track.translations.end() - 3,
+                                  track.translations.end());
+      while (track.rotations.size() < 4 * keys)
+        track.rotations.insert(track.rotations.end(), track.rotations.end() - 4, track.rotations.end());
       animate(id, "translation", b.floats(track.translations.data(), keys, 3), "LINEAR");
       animate(id, "rotation", b.floats(track.rotations.data(), keys, 4), "LINEAR");
       std::vector<float>().swap(track.translations);

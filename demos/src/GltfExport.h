@@ -35,19 +35,19 @@ class GltfRecorder {
 
  private:
   struct ColliderTrack {
-    Collider shape;                  ///< Shape, size and name (poses ignored).
-    std::vector<float> translations; ///< x, y, z per frame.
-    std::vector<float> rotations;    ///< x, y, z, w per frame.
+    Collider shape;                   ///< Shape, size and name (poses ignored).
+    std::vector<float> translations;  ///< x, y, z per frame.
+    std::vector<float> rotations;     ///< x, y, z, w per frame.
   };
   struct CharacterTrack {
     std::vector<ColliderTrack> colliders;
-    CapeMesh mesh;                      ///< Scratch for positions and normals.
+    CapeMesh mesh;  ///< Scratch for positions and normals.
     std::size_t vertices = 0;
-    std::vector<float> basePositions;   ///< First frame, x, y, z per vertex.
+    std::vector<float> basePositions;  ///< First frame, x, y, z per vertex.
     std::vector<float> baseNormals;
     std::vector<std::uint32_t> indices;
-    std::vector<float> uvs;             ///< u, v per vertex.
-    std::vector<float> morphs;          ///< Per later frame: position deltas then normal deltas (3n each).
+    std::vector<float> uvs;     ///< u, v per vertex.
+    std::vector<float> morphs;  ///< Per later frame: position deltas then normal deltas (3n each).
     std::vector<float> morphMin, morphMax;  ///< Per later frame: bounds of the position deltas (x, y, z).
   };
   int characters_;

@@ -2,8 +2,8 @@
 
 #include "ShapeMesh.h"
 
-#include <GL/osmesa.h>
 #include <GL/gl.h>
+#include <GL/osmesa.h>
 #include <png.h>
 
 #include <algorithm>
@@ -19,8 +19,8 @@ namespace fs = std::filesystem;
 
 // --- Camera -----------------------------------------------------------------------------------------------
 
-Camera Camera::lookAt(const Vec3& eye, const Vec3& target, int width, int height, float fovYDegrees, float zNear,
-                      float zFar) {
+Camera Camera::lookAt(const Vec3& eye, const Vec3& target, int width, int height, float fovYDegrees,
+                      float zNear, float zFar) {
   Camera c;
   c.width = width;
   c.height = height;
@@ -49,7 +49,8 @@ bool Camera::project(const Vec3& world, Eigen::Vector2f& pixel) const {
   const Vec4 clip = projection * view * Vec4(world.x(), world.y(), world.z(), 1.0f);
   if (clip.w() <= 1e-6f) return false;
   const float x = clip.x() / clip.w(), y = clip.y() / clip.w();
-  pixel = Eigen::Vector2f(0.5f * (x + 1.0f) * static_cast<float>(width), 0.5f * (1.0f - y) * static_cast<float>(height));
+  pixel = Eigen::Vector2f(0.5f * (x + 1.0f) * static_cast<float>(width),
+                          0.5f * (1.0f - y) * static_cast<float>(height));
   return true;
 }
 
@@ -73,11 +74,12 @@ bool writePngFile(std::FILE* file, const std::uint8_t* rgba, int width, int heig
   }
   png_init_io(png, file);
   png_set_compression_level(png, compression);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
+               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
   png_set_filler(png, 0, PNG_FILLER_AFTER);  // the rows are RGBA: drop the fourth byte
-  for (int y = 0; y < height; ++y) png_write_row(png, rgba + static_cast<std::size_t>(y) * static_cast<std::size_t>(width) * 4);
+  for (int y = 0; y < height; ++y)
+    png_write_row(png, rgba + static_cast<std::size_t>(y) * static_cast<std::size_t>(width) * 4);
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   return true;
@@ -91,7 +93,8 @@ bool writePng(const fs::path& file, const Image& image, std::string& error, int 
     error = "cannot write " + file.string();
     return false;
   }
-  const bool ok = writePngFile(f, image.rgba.data(), image.width, image.height, std::clamp(compression, 0, 9));
+  const bool ok =
+      writePngFile(f, image.rgba.data(), image.width, image.height, std::clamp(compression, 0, 9));
   if (std::fclose(f) != 0 || !ok) {
     error = "cannot write PNG " + file.string();
     return false;
@@ -129,8 +132,17 @@ Renderer::Renderer(int width, int height, int supersample)
     error_ = "image size " + std::to_string(width) + "x" + std::to_string(height) + " outside 16..4096";
     return;
   }
-  const GLint attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 0,
-                              OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_COMPAT_PROFILE, 0};
+  const GLint attributes[] = {OSMESA_FORMAT,
+                              OSMESA_RGBA,
+                              OSMESA_DEPTH_BITS,
+                              24,
+                              OSMESA_STENCIL_BITS,
+                              0,
+                              OSMESA_ACCUM_BITS,
+                              0,
+                              OSMESA_PROFILE,
+                              OSMESA_COMPAT_PROFILE,
+                              0};
   OSMesaContext context = OSMesaCreateContextAttribs(attributes, nullptr);
   if (!context) context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
   if (!context) {
@@ -138,8 +150,10 @@ Renderer::Renderer(int width, int height, int supersample)
     return;
   }
   context_ = context;
-  buffer_.resize(static_cast<std::size_t>(width_ * supersample_) * static_cast<std::size_t>(height_ * supersample_) * 4);
-  if (!OSMesaMakeCurrent(context, buffer_.data(), GL_UNSIGNED_BYTE, width_ * supersample_, height_ * supersample_)) {
+  buffer_.resize(static_cast<std::size_t>(width_ * supersample_) *
+                 static_cast<std::size_t>(height_ * supersample_) * 4);
+  if (!OSMesaMakeCurrent(context, buffer_.data(), GL_UNSIGNED_BYTE, width_ * supersample_,
+                         height_ * supersample_)) {
     error_ = "cannot make the OSMesa context current";
     return;
   }
@@ -150,14 +164,15 @@ Renderer::Renderer(int width, int height, int supersample)
 
 Renderer::~Renderer() {
   if (!context_) return;
-  if (OSMesaGetCurrentContext() == static_cast<OSMesaContext>(context_)) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+  if (OSMesaGetCurrentContext() == static_cast<OSMesaContext>(context_))
+    OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
   OSMesaDestroyContext(static_cast<OSMesaContext>(context_));
 }
 
 void Renderer::begin(const Camera& camera, const Colour& background, bool lighting) {
   if (!ok()) return;
-  OSMesaMakeCurrent(static_cast<OSMesaContext>(context_), buffer_.data(), GL_UNSIGNED_BYTE, width_ * supersample_,
-                    height_ * supersample_);
+  OSMesaMakeCurrent(static_cast<OSMesaContext>(context_), buffer_.data(), GL_UNSIGNED_BYTE,
+                    width_ * supersample_, height_ * supersample_);
   lighting_ = lighting;
   glViewport(0, 0, width_ * supersample_, height_ * supersample_);
   glClearColor(background.x(), background.y(), background.z(), 1.0f);
@@ -246,8 +261,8 @@ void Renderer::drawGround(const Vec3& centre, float halfSize) {
 
 const Renderer::GpuMesh& Renderer::shapeMesh(const Collider& c) {
   char key[160];
-  std::snprintf(key, sizeof(key), "%d %.5g %.5g %d %.5g %.5g %.5g", static_cast<int>(c.shape), c.radius, c.halfHeight,
-                c.axis, c.halfExtents.x(), c.halfExtents.y(), c.halfExtents.z());
+  std::snprintf(key, sizeof(key), "%d %.5g %.5g %d %.5g %.5g %.5g", static_cast<int>(c.shape), c.radius,
+                c.halfHeight, c.axis, c.halfExtents.x(), c.halfExtents.y(), c.halfExtents.z());
   auto it = shapes_.find(key);
   if (it != shapes_.end()) return it->second;
   const ShapeMesh shape = colliderMesh(c, 32);
@@ -286,7 +301,8 @@ void Renderer::drawColliders(const std::vector<Collider>& colliders, const Colou
 
 void Renderer::drawCape(const Cape& cape, const Colour& outside, const Colour& lining) {
   if (!ok() || cape.fabric().particleCount() == 0) return;
-  if (capeFabric_ != &cape.fabric() || capeMesh_.positions.rows() != static_cast<Eigen::Index>(cape.fabric().particleCount())) {
+  if (capeFabric_ != &cape.fabric() ||
+      capeMesh_.positions.rows() != static_cast<Eigen::Index>(cape.fabric().particleCount())) {
     capeMesh_.allocate(cape.fabric(), false);
     capeFabric_ = &cape.fabric();
   }
@@ -325,12 +341,16 @@ const Image& Renderer::finish() {
   const int s = supersample_, bw = width_ * s, bh = height_ * s;
   const int weight = s * s;
   for (int y = 0; y < height_; ++y) {
-    std::uint8_t* out = image_.rgba.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) * 4;
+    std::uint8_t* out =
+        image_.rgba.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) * 4;
     const int by = bh - (y + 1) * s;  // first buffer row of this image row's block
     for (int x = 0; x < width_; ++x) {
       int sum[4] = {0, 0, 0, 0};
       for (int dy = 0; dy < s; ++dy) {
-        const std::uint8_t* in = buffer_.data() + (static_cast<std::size_t>(by + dy) * static_cast<std::size_t>(bw) + static_cast<std::size_t>(x * s)) * 4;
+        const std::uint8_t* in =
+            buffer_.data() + (static_cast<std::size_t>(by + dy) * static_cast<std::size_t>(bw) +
+                              static_cast<std::size_t>(x * s)) *
+                                 4;
         for (int dx = 0; dx < s; ++dx, in += 4) {
           sum[0] += in[0];
           sum[1] += in[1];
@@ -428,7 +448,8 @@ void RunRenderer::renderFrame() {
   const Vec3 forward(-std::sin(heading_), 0.0f, -std::cos(heading_));
   const Vec3 left(-std::cos(heading_), 0.0f, std::sin(heading_));
   const Vec3 target(centre.x(), 1.0f, centre.z());
-  const Vec3 eye = target - (2.8f + 1.2f * spread) * forward + (1.5f + 0.6f * spread) * left + Vec3(0, 0.6f, 0);
+  const Vec3 eye =
+      target - (2.8f + 1.2f * spread) * forward + (1.5f + 0.6f * spread) * left + Vec3(0, 0.6f, 0);
   camera_ = Camera::lookAt(eye, target, renderer_->width(), renderer_->height(), 40.0f);
 
   renderer_->begin(camera_);
@@ -457,7 +478,8 @@ bool RunRenderer::finish(std::string& error) {
     return false;
   }
   if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0) {
-    std::printf("cape_walk: ffmpeg is not on PATH: no run.mp4 or run.gif; the frames are in %s\n", dir_.c_str());
+    std::printf("cape_walk: ffmpeg is not on PATH: no run.mp4 or run.gif; the frames are in %s\n",
+                dir_.c_str());
     return true;
   }
   const std::string frames = shellQuote((dir_ / "%05d.png").string());
@@ -468,10 +490,11 @@ bool RunRenderer::finish(std::string& error) {
     error = "ffmpeg could not write " + (dir_ / "run.mp4").string();
     return false;
   }
-  const std::string gif = "ffmpeg -y -loglevel error -framerate 60 -i " + frames +
-                          " -vf \"fps=30,scale=320:-2:flags=lanczos,split[a][b];[a]palettegen=max_colors=96[p];"
-                          "[b][p]paletteuse=dither=bayer:bayer_scale=3\" " +
-                          shellQuote((dir_ / "run.gif").string());
+  const std::string gif =
+      "ffmpeg -y -loglevel error -framerate 60 -i " + frames +
+      " -vf \"fps=20,scale=320:-2:flags=lanczos,split[a][b];[a]palettegen=max_colors=64:stats_mode=diff[p];"
+      "[b][p]paletteuse=dither=bayer:bayer_scale=5:diff_mode=rectangle\" " +
+      shellQuote((dir_ / "run.gif").string());
   if (std::system(gif.c_str()) != 0) {
     error = "ffmpeg could not write " + (dir_ / "run.gif").string();
     return false;

@@ -41,7 +41,9 @@ using Colour = Eigen::Vector3f;
 struct Image {
   int width = 0, height = 0;
   std::vector<std::uint8_t> rgba;
-  const std::uint8_t* pixel(int x, int y) const { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
+  const std::uint8_t* pixel(int x, int y) const {
+    return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4;
+  }
 };
 
 /// Writes RGB from an RGBA image as an 8-bit PNG (zlib level 0..9). False with a reason on failure.
@@ -63,11 +65,13 @@ class Renderer {
   int height() const { return height_; }
 
   /// Clears to `background`, loads the camera and sets the lights; `lighting` false draws flat colours.
-  void begin(const Camera& camera, const Colour& background = Colour(0.80f, 0.86f, 0.93f), bool lighting = true);
+  void begin(const Camera& camera, const Colour& background = Colour(0.80f, 0.86f, 0.93f),
+             bool lighting = true);
   /// The ground y = 0: a light plane with 1 m grid lines (darker every 5 m) within `halfSize` m of `centre`.
   void drawGround(const Vec3& centre, float halfSize = 30.0f);
   /// Colliders as their true shapes (planes are skipped: drawGround draws the ground).
-  void drawColliders(const std::vector<Collider>& colliders, const Colour& colour = Colour(0.50f, 0.60f, 0.75f));
+  void drawColliders(const std::vector<Collider>& colliders,
+                     const Colour& colour = Colour(0.50f, 0.60f, 0.75f));
   /// The cape, smooth shaded with its per-vertex normals, `outside` on its front (counter-clockwise) faces
   /// and `lining` on its back.
   void drawCape(const Cape& cape, const Colour& outside = Colour(0.70f, 0.06f, 0.08f),
@@ -94,13 +98,13 @@ class Renderer {
   bool lighting_ = true;
   CapeMesh capeMesh_;
   const Fabric* capeFabric_ = nullptr;
-  std::vector<float> capeVertices_;   ///< Interleaved position and normal, refreshed per draw.
+  std::vector<float> capeVertices_;        ///< Interleaved position and normal, refreshed per draw.
   std::map<std::string, GpuMesh> shapes_;  ///< Collider meshes by shape and size.
 };
 
 /// Renders a run frame by frame into a folder: DIR/00001.png, ... and, with ffmpeg on PATH, DIR/run.mp4
-/// (H.264, 60 fps) and DIR/run.gif (30 fps, 320 px wide). The camera follows the characters from behind and
-/// to their left, looking at the torso, turning with their heading.
+/// (H.264, 60 fps) and DIR/run.gif (every third frame, 320 px wide, 64 colours). The camera follows the
+/// characters from behind and to their left, looking at the torso, turning with their heading.
 class RunRenderer {
  public:
   /// Creates the folder. Check ok(): false with a reason if the folder or the GL context cannot be made.

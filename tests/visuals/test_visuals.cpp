@@ -20,12 +20,15 @@ namespace fs = std::filesystem;
 
 // Mesa's OSMesa keeps a few small framebuffer records after OSMesaDestroyContext (848 bytes per process, made
 // inside OSMesaMakeCurrent); they are Mesa's, so LeakSanitizer ignores allocations made inside libOSMesa.
-extern "C" const char* __lsan_default_suppressions() { return "leak:libOSMesa.so\n"; }
+extern "C" const char* __lsan_default_suppressions() {
+  return "leak:libOSMesa.so\n";
+}
 
 namespace {
 
 fs::path freshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("cape_visuals_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("cape_visuals_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -42,7 +45,8 @@ std::vector<float> readFloats(const tinygltf::Model& m, int accessor) {
   const tinygltf::BufferView& v = m.bufferViews.at(static_cast<std::size_t>(a.bufferView));
   const int components = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
   std::vector<float> out(a.count * static_cast<std::size_t>(components));
-  std::memcpy(out.data(), m.buffers.at(static_cast<std::size_t>(v.buffer)).data.data() + v.byteOffset + a.byteOffset,
+  std::memcpy(out.data(),
+              m.buffers.at(static_cast<std::size_t>(v.buffer)).data.data() + v.byteOffset + a.byteOffset,
               out.size() * sizeof(float));
   return out;
 }
@@ -60,7 +64,8 @@ TEST(ShapeMesh, VerticesOnTheTrueSurfaceAndTrianglesFacingOut) {
     for (std::size_t i = 0; i < mesh.vertexCount(); ++i) {
       const Vec3 p(mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]);
       EXPECT_NEAR(localSignedDistance(c, p).distance, 0.0f, 1e-5f);
-      EXPECT_NEAR(Vec3(mesh.normals[3 * i], mesh.normals[3 * i + 1], mesh.normals[3 * i + 2]).norm(), 1.0f, 1e-5f);
+      EXPECT_NEAR(Vec3(mesh.normals[3 * i], mesh.normals[3 * i + 1], mesh.normals[3 * i + 2]).norm(), 1.0f,
+                  1e-5f);
     }
     int facingOut = 0, degenerate = 0;
     for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
@@ -141,11 +146,13 @@ TEST(GltfExport, RunLoadsBackWithNodesMeshesAnimationAndFrameTimes) {
     const std::vector<float> x = readFloats(m, s.output);
     for (int f = 0; f < frames; f += 7) {
       const Vec3& p = colliderFrames[static_cast<std::size_t>(f)][k].current.position;
-      for (int a = 0; a < 3; ++a) EXPECT_FLOAT_EQ(x[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(a)], p[a]);
+      for (int a = 0; a < 3; ++a)
+        EXPECT_FLOAT_EQ(x[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(a)], p[a]);
     }
   }
   ASSERT_GE(capeNode, 0);
-  const tinygltf::Mesh& cape = m.meshes.at(static_cast<std::size_t>(m.nodes[static_cast<std::size_t>(capeNode)].mesh));
+  const tinygltf::Mesh& cape =
+      m.meshes.at(static_cast<std::size_t>(m.nodes[static_cast<std::size_t>(capeNode)].mesh));
   ASSERT_EQ(cape.primitives.size(), 1u);
   const tinygltf::Primitive& p = cape.primitives[0];
   EXPECT_TRUE(m.materials.at(static_cast<std::size_t>(p.material)).doubleSided);
@@ -162,7 +169,8 @@ TEST(GltfExport, RunLoadsBackWithNodesMeshesAnimationAndFrameTimes) {
     const Points& want = capePositions[static_cast<std::size_t>(f)];
     ASSERT_EQ(x.size(), static_cast<std::size_t>(want.rows()) * 3);
     for (Eigen::Index i = 0; i < want.rows(); ++i) {
-      for (int a = 0; a < 3; ++a) EXPECT_NEAR(x[static_cast<std::size_t>(i) * 3 + static_cast<std::size_t>(a)], want(i, a), 1e-5f);
+      for (int a = 0; a < 3; ++a)
+        EXPECT_NEAR(x[static_cast<std::size_t>(i) * 3 + static_cast<std::size_t>(a)], want(i, a), 1e-5f);
     }
   }
   fs::remove_all(file.parent_path());
@@ -199,12 +207,14 @@ TEST(Renderer, CapePixelsAreWhereItsVerticesProject) {
   const Vec3 eye = camera.eye();
   int checked = 0;
   for (std::size_t t = 0; t < tri.size(); t += 3 * 7) {  // every seventh triangle
-    const Vec3 a = x.row(tri[t]).transpose(), b = x.row(tri[t + 1]).transpose(), c = x.row(tri[t + 2]).transpose();
+    const Vec3 a = x.row(tri[t]).transpose(), b = x.row(tri[t + 1]).transpose(),
+               c = x.row(tri[t + 2]).transpose();
     const Vec3 centroid = (a + b + c) / 3.0f;
     const Vec3 normal = (b - a).cross(c - a);
     if (std::abs(normal.normalized().dot((eye - centroid).normalized())) < 0.3f) continue;  // seen edge-on
     Eigen::Vector2f pa, pb, pc, pm;
-    ASSERT_TRUE(camera.project(a, pa) && camera.project(b, pb) && camera.project(c, pc) && camera.project(centroid, pm));
+    ASSERT_TRUE(camera.project(a, pa) && camera.project(b, pb) && camera.project(c, pc) &&
+                camera.project(centroid, pm));
     // Only triangles at least a few pixels across, so their centroid pixel is inside them.
     const float area = 0.5f * std::abs((pb - pa).x() * (pc - pa).y() - (pb - pa).y() * (pc - pa).x());
     if (area < 12.0f) continue;
@@ -246,7 +256,8 @@ TEST(RunRenderer, FramesHaveTheRequestedSizeAndAreNotBlank) {
   }
   ASSERT_TRUE(renderer.ok()) << renderer.error();
   EXPECT_EQ(renderer.frames(), 3);
-  for (const char* name : {"00001.png", "00002.png", "00003.png"}) EXPECT_TRUE(fs::exists(dir / name)) << name;
+  for (const char* name : {"00001.png", "00002.png", "00003.png"})
+    EXPECT_TRUE(fs::exists(dir / name)) << name;
 
   // Read back the last frame through the same renderer settings: the size and a picture with content
   // (ground, body and cape in many colours, not one flat colour).
