@@ -18,12 +18,6 @@ using namespace cape;
 using namespace cape::demo;
 namespace fs = std::filesystem;
 
-// Mesa's OSMesa keeps a few small framebuffer records after OSMesaDestroyContext (848 bytes per process, made
-// inside OSMesaMakeCurrent); they are Mesa's, so LeakSanitizer ignores allocations made inside libOSMesa.
-extern "C" const char* __lsan_default_suppressions() {
-  return "leak:libOSMesa.so\n";
-}
-
 namespace {
 
 fs::path freshDir(const std::string& name) {
