@@ -16,7 +16,9 @@
 // Mesa's OSMesa keeps a few small framebuffer records after OSMesaDestroyContext (848 bytes per process, made
 // inside OSMesaMakeCurrent). They are Mesa's, so in sanitizer builds LeakSanitizer ignores allocations made
 // inside libOSMesa, for every program that renders (the hook is only read by the sanitizer runtime).
-extern "C" const char* __lsan_default_suppressions() { return "leak:libOSMesa.so\n"; }
+extern "C" const char* __lsan_default_suppressions() {
+  return "leak:libOSMesa.so\n";
+}
 
 namespace cape::demo {
 
@@ -54,8 +56,8 @@ bool Camera::project(const Vec3& world, Eigen::Vector2f& pixel) const {
   const Vec4 clip = projection * view * Vec4(world.x(), world.y(), world.z(), 1.0f);
   if (clip.w() <= 1e-6f) return false;
   const float x = clip.x() / clip.w(), y = clip.y() / clip.w();
-  pixel = Eigen::Vector2f(0.5f * (x + 1.0f) * static_cast<float>(width),
-                          0.5f * (1.0f - y) * static_cast<float>(height));
+  pixel = Eigen::Vector2f(static_cast<float>(this->x) + 0.5f * (x + 1.0f) * static_cast<float>(width),
+                          static_cast<float>(this->y) + 0.5f * (1.0f - y) * static_cast<float>(height));
   return true;
 }
 
@@ -179,7 +181,12 @@ void Renderer::begin(const Camera& camera, const Colour& background, bool lighti
   OSMesaMakeCurrent(static_cast<OSMesaContext>(context_), buffer_.data(), GL_UNSIGNED_BYTE,
                     width_ * supersample_, height_ * supersample_);
   lighting_ = lighting;
-  glViewport(0, 0, width_ * supersample_, height_ * supersample_);
+  // The camera's panel (the whole image unless it says otherwise); GL counts rows from the bottom.
+  const int s = supersample_;
+  const int panelX = camera.x * s, panelY = (height_ - camera.y - camera.height) * s;
+  glViewport(panelX, panelY, camera.width * s, camera.height * s);
+  glScissor(panelX, panelY, camera.width * s, camera.height * s);
+  glEnable(GL_SCISSOR_TEST);
   glClearColor(background.x(), background.y(), background.z(), 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
@@ -383,8 +390,12 @@ std::string shellQuote(const std::string& text) {
   return q + "'";
 }
 
-RunRenderer::RunRenderer(const fs::path& dir, int characters, int width, int height)
-    : dir_(dir), characters_(std::max(characters, 1)), pending_(static_cast<std::size_t>(characters_)) {
+RunRenderer::RunRenderer(const fs::path& dir, int characters, int width, int height, Layout layout)
+    : dir_(dir),
+      characters_(std::max(characters, 1)),
+      pending_(static_cast<std::size_t>(characters_)),
+      layout_(layout),
+      views_(layout == Layout::SideBySide ? static_cast<std::size_t>(characters_) : 1) {
   std::error_code ec;
   fs::create_directories(dir_, ec);
   if (ec || !fs::is_directory(dir_)) {
@@ -413,21 +424,20 @@ void RunRenderer::record(int character, const CapeMesh& mesh, const std::vector<
   if (character == characters_ - 1) renderFrame();
 }
 
-void RunRenderer::renderFrame() {
-  const auto start = std::chrono::steady_clock::now();
+void RunRenderer::follow(View& view, const std::vector<const Pending*>& characters, int x, int width) {
   // Where the characters are: the mean of their colliders' centres (the cape's, without colliders).
   std::vector<Vec3> centres;
-  for (const Pending& p : pending_) {
-    if (!p.cape && !p.mesh) continue;
+  for (const Pending* p : characters) {
+    if (!p->cape && !p->mesh) continue;
     Vec3 c = Vec3::Zero();
     int count = 0;
-    for (const Collider& col : p.colliders) {
+    for (const Collider& col : p->colliders) {
       if (col.shape == ColliderShape::Plane) continue;
       c += col.current.position;
       ++count;
     }
     if (count == 0) {
-      c = (p.cape ? p.cape->state().positions : p.mesh->positions).colwise().mean().transpose();
+      c = (p->cape ? p->cape->state().positions : p->mesh->positions).colwise().mean().transpose();
       count = 1;
     }
     centres.push_back(c / static_cast<float>(count));
@@ -439,30 +449,55 @@ void RunRenderer::renderFrame() {
   for (const Vec3& c : centres) spread = std::max(spread, (c - centre).norm());
 
   // Turn with the heading of the motion (kept while standing), smoothed over about 0.35 s.
-  const float dt = 1.0f / 60.0f;
-  if (frame_ > 0) {
-    const Vec3 v = (centre - lastCentre_) / dt;
+  const float dt = 1.0f / 60.0f, kTwoPi = 6.28318530718f;
+  if (view.started) {
+    const Vec3 v = (centre - view.lastCentre) / dt;
     if (std::hypot(v.x(), v.z()) > 0.5f) {
       const float target = std::atan2(-v.x(), -v.z());
-      float delta = std::remainder(target - heading_, 6.28318530718f);
-      heading_ += delta * (1.0f - std::exp(-dt / 0.35f));
-      heading_ = std::remainder(heading_, 6.28318530718f);
+      const float delta = std::remainder(target - view.heading, kTwoPi);
+      view.heading = std::remainder(view.heading + delta * (1.0f - std::exp(-dt / 0.35f)), kTwoPi);
     }
   }
-  lastCentre_ = centre;
-  const Vec3 forward(-std::sin(heading_), 0.0f, -std::cos(heading_));
-  const Vec3 left(-std::cos(heading_), 0.0f, std::sin(heading_));
+  view.started = true;
+  view.lastCentre = centre;
+  const Vec3 forward(-std::sin(view.heading), 0.0f, -std::cos(view.heading));
+  const Vec3 left(-std::cos(view.heading), 0.0f, std::sin(view.heading));
   const Vec3 target(centre.x(), 1.0f, centre.z());
-  const Vec3 eye =
-      target - (2.8f + 1.2f * spread) * forward + (1.5f + 0.6f * spread) * left + Vec3(0, 0.6f, 0);
-  camera_ = Camera::lookAt(eye, target, renderer_->width(), renderer_->height(), 40.0f);
+  // Behind and to the left, a little above the torso; farther back for a wide crowd or a narrow panel.
+  const float aspect = static_cast<float>(width) / static_cast<float>(renderer_->height());
+  const float back = (2.8f + 1.2f * spread) * std::max(1.0f, 1.6f / aspect);
+  const Vec3 eye = target - back * forward + (1.5f + 0.6f * spread) * left + Vec3(0, 0.6f, 0);
+  view.camera = Camera::lookAt(eye, target, width, renderer_->height(), 40.0f);
+  view.camera.x = x;
+}
 
-  renderer_->begin(camera_);
-  renderer_->drawGround(target, 40.0f);
-  for (const Pending& p : pending_) {
-    renderer_->drawColliders(p.colliders);
-    if (p.cape) renderer_->drawCape(*p.cape);
-    if (p.mesh) renderer_->drawCape(*p.mesh);
+void RunRenderer::renderFrame() {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<const Pending*> all;
+  for (const Pending& p : pending_) all.push_back(&p);
+  if (layout_ == Layout::Together) {
+    follow(views_[0], all, 0, renderer_->width());
+    renderer_->begin(views_[0].camera);
+    renderer_->drawGround(views_[0].lastCentre, 40.0f);
+    for (const Pending* p : all) {
+      renderer_->drawColliders(p->colliders);
+      if (p->cape) renderer_->drawCape(*p->cape);
+      if (p->mesh) renderer_->drawCape(*p->mesh);
+    }
+  } else {
+    // Panels of equal width, a 2 pixel gap between them (left as the clear colour of no panel: black).
+    const int panels = static_cast<int>(views_.size()), gap = 2;
+    const int width = (renderer_->width() - gap * (panels - 1)) / panels;
+    for (int k = 0; k < panels; ++k) {
+      View& view = views_[static_cast<std::size_t>(k)];
+      const Pending* p = all[static_cast<std::size_t>(k)];
+      follow(view, {p}, k * (width + gap), width);
+      renderer_->begin(view.camera);
+      renderer_->drawGround(view.lastCentre, 40.0f);
+      renderer_->drawColliders(p->colliders);
+      if (p->cape) renderer_->drawCape(*p->cape);
+      if (p->mesh) renderer_->drawCape(*p->mesh);
+    }
   }
   const Image& image = renderer_->finish();
   renderMs_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -23,7 +23,8 @@ using Mat4 = Eigen::Matrix4f;
 struct Camera {
   Mat4 view = Mat4::Identity();
   Mat4 projection = Mat4::Identity();
-  int width = 640, height = 360;
+  int width = 640, height = 360;  ///< The image (or the panel of it) the camera maps to, pixels.
+  int x = 0, y = 0;               ///< The panel's top-left corner in the image, pixels.
 
   /// Looks from `eye` at `target` with +Y up; vertical field of view in degrees; near and far in m.
   static Camera lookAt(const Vec3& eye, const Vec3& target, int width, int height, float fovYDegrees = 40.0f,
@@ -64,7 +65,8 @@ class Renderer {
   int width() const { return width_; }
   int height() const { return height_; }
 
-  /// Clears to `background`, loads the camera and sets the lights; `lighting` false draws flat colours.
+  /// Clears the camera's panel to `background`, loads the camera and sets the lights; `lighting` false draws
+  /// flat colours. Several panels may be drawn (each after its own begin()) before finish().
   void begin(const Camera& camera, const Colour& background = Colour(0.80f, 0.86f, 0.93f),
              bool lighting = true);
   /// The ground y = 0: a light plane with 1 m grid lines (darker every 5 m) within `halfSize` m of `centre`.
@@ -82,6 +84,8 @@ class Renderer {
                 const Colour& lining = Colour(0.85f, 0.66f, 0.22f));
   /// Finishes the frame and returns the image (valid until the next finish()).
   const Image& finish();
+  /// The image of the last finish().
+  const Image& image() const { return image_; }
 
  private:
   struct GpuMesh {
@@ -108,7 +112,11 @@ class Renderer {
 class RunRenderer {
  public:
   /// Creates the folder. Check ok(): false with a reason if the folder or the GL context cannot be made.
-  RunRenderer(const std::filesystem::path& dir, int characters, int width = 640, int height = 360);
+  /// Together: one camera on every character (a crowd). SideBySide: each character in its own panel, left to
+  /// right, with its own camera (a comparison of two capes on twin characters).
+  enum class Layout { Together, SideBySide };
+  RunRenderer(const std::filesystem::path& dir, int characters, int width = 640, int height = 360,
+              Layout layout = Layout::Together);
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
 
@@ -124,8 +132,9 @@ class RunRenderer {
   int frames() const { return frame_; }
   /// Mean wall time per frame of drawing and reading back (PNG writing excluded), ms.
   double meanRenderMs() const { return frame_ > 0 ? renderMs_ / frame_ : 0.0; }
-  /// The camera of the last frame.
-  const Camera& camera() const { return camera_; }
+  /// The camera of a panel (0 with Together) in the last frame, and the last frame itself.
+  const Camera& camera(int panel = 0) const { return views_.at(static_cast<std::size_t>(panel)).camera; }
+  const Image& lastImage() const { return renderer_->image(); }
 
  private:
   void renderFrame();
@@ -140,9 +149,16 @@ class RunRenderer {
     std::vector<Collider> colliders;
   };
   std::vector<Pending> pending_;
-  Camera camera_;
-  Vec3 lastCentre_ = Vec3::Zero();
-  float heading_ = 0.0f;  ///< rad about +Y; 0 faces -Z
+  /// A following camera: where its characters were and the heading it turned to.
+  struct View {
+    Camera camera;
+    Vec3 lastCentre = Vec3::Zero();
+    float heading = 0.0f;  ///< rad about +Y; 0 faces -Z
+    bool started = false;
+  };
+  void follow(View& view, const std::vector<const Pending*>& characters, int x, int width);
+  Layout layout_;
+  std::vector<View> views_;
   int frame_ = 0;
   double renderMs_ = 0.0;
 };

@@ -289,3 +289,47 @@ TEST(RunRenderer, UncreatableFolderFailsWithAReason) {
   EXPECT_FALSE(renderer.ok());
   EXPECT_NE(renderer.error().find("/proc/no/such/folder"), std::string::npos) << renderer.error();
 }
+
+TEST(RunRenderer, SideBySidePanelsEachShowTheirOwnCape) {
+  // Two capes on twin characters (the second handed over as a mesh, as a btSoftBody twin would be).
+  SimpleScene ours(SceneKind::Walk, 10, Attachment::Corners, CapeSettings());
+  SimpleScene twin(SceneKind::Walk, 10, Attachment::Collar, CapeSettings());
+  const fs::path dir = freshDir("side_by_side");
+  RunRenderer renderer(dir, 2, 320, 120, RunRenderer::Layout::SideBySide);
+  ASSERT_TRUE(renderer.ok()) << renderer.error();
+  CapeMesh twinMesh;
+  twinMesh.allocate(twin.cape().fabric(), false);
+  for (int f = 0; f < 20; ++f) {
+    ours.advanceFrame();
+    twin.advanceFrame();
+    twinMesh.update(twin.cape().fabric(), twin.cape().state().positions);
+    renderer.record(0, ours.cape(), bodyOf(ours));
+    renderer.record(1, twinMesh, bodyOf(twin));
+  }
+  EXPECT_EQ(renderer.frames(), 20);
+  const Image& image = renderer.lastImage();
+  ASSERT_EQ(image.width, 320);
+  ASSERT_EQ(image.height, 120);
+  // Each panel's camera puts its own cape's centre inside that panel, and the pixels there are the cape's.
+  for (int panel = 0; panel < 2; ++panel) {
+    SCOPED_TRACE(panel);
+    const Camera& camera = renderer.camera(panel);
+    EXPECT_EQ(camera.x, panel * 161);
+    EXPECT_EQ(camera.width, 159);
+    const SimpleScene& scene = panel == 0 ? ours : twin;
+    int reddish = 0;
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = camera.x; x < camera.x + camera.width; ++x) {
+        const std::uint8_t* p = image.pixel(x, y);
+        reddish += p[0] > 2 * p[1] && p[0] > 2 * p[2] && p[0] > 60;
+      }
+    }
+    EXPECT_GT(reddish, 100);
+    Eigen::Vector2f pixel;
+    const Vec3 middle = scene.cape().state().positions.row(10 * 5 + 5).transpose();
+    ASSERT_TRUE(camera.project(middle, pixel));
+    EXPECT_GE(pixel.x(), camera.x);
+    EXPECT_LT(pixel.x(), camera.x + camera.width);
+  }
+  fs::remove_all(dir);
+}
