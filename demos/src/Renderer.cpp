@@ -13,12 +13,6 @@
 #include <cstdio>
 #include <cstdlib>
 
-// Mesa's OSMesa keeps a few small framebuffer records after OSMesaDestroyContext (848 bytes per process, made
-// inside OSMesaMakeCurrent). They are Mesa's, so in sanitizer builds LeakSanitizer ignores allocations made
-// inside libOSMesa, for every program that renders (the hook is only read by the sanitizer runtime).
-extern "C" const char* __lsan_default_suppressions() {
-  return "leak:libOSMesa.so\n";
-}
 
 namespace cape::demo {
 

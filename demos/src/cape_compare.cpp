@@ -5,6 +5,7 @@
 #include "BulletScene.h"
 #include "Plots.h"
 #include "Progress.h"
+#include "Renderer.h"
 #include "RunOutput.h"
 
 #include "cape/bullet/CapeAction.h"
@@ -101,6 +102,9 @@ class TwinRun {
   }
   int characterCount() const { return scene_->characterCount(); }
   const Fabric& fabric() const { return *scene_->rig().fabric; }
+  /// Node positions of character k's twin as of the last measure(k), m.
+  const Points& positions(int k) const { return positions_[static_cast<std::size_t>(k)]; }
+  std::vector<Collider> bodyColliders(int k) const { return scene_->bodyColliders(k); }
 
  private:
   std::unique_ptr<BulletScene> scene_;
@@ -135,6 +139,7 @@ int main(int argc, char** argv) {
   int size = 20, characters = 3, iterations = 10;
   double seconds = -1.0;
   bool simpleBody = false, noPlots = false;
+  std::string render, renderSize = "960x360";
   app.add_option("--scene", scene, "hang | walk | sprint-turn | wind | crowd")
       ->check(CLI::IsMember({"hang", "walk", "sprint-turn", "wind", "crowd"}))
       ->capture_default_str();
@@ -150,6 +155,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--out", out, "output folder (default: a fresh cape_compare_<scene>_<time> folder)");
   app.add_flag("--no-plots", noPlots, "do not draw the PNG plots");
+  app.add_option("--render", render,
+                 "also render both capes side by side (ours left, btSoftBody right) as PNG frames, and run.mp4 and "
+                 "run.gif with ffmpeg, into this folder");
+  app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   RunOptions o;
@@ -208,6 +217,23 @@ int main(int argc, char** argv) {
     return 1;
   }
 
+  // Side by side: ours on the left, the twin on the right, each with its own camera (the first character).
+  std::unique_ptr<RunRenderer> renderer;
+  CapeMesh twinMesh;
+  if (!render.empty()) {
+    int w = 0, h = 0;
+    if (std::sscanf(renderSize.c_str(), "%dx%d", &w, &h) != 2) {
+      std::fprintf(stderr, "cape_compare: --render-size %s is not WxH\n", renderSize.c_str());
+      return 1;
+    }
+    renderer = std::make_unique<RunRenderer>(render, 2, w, h, RunRenderer::Layout::SideBySide);
+    if (!renderer->ok()) {
+      std::fprintf(stderr, "cape_compare: %s\n", renderer->error().c_str());
+      return 1;
+    }
+    twinMesh.allocate(twinRun.fabric(), false);
+  }
+
   const double length = o.seconds > 0.0 ? o.seconds : MotionDesc::forScene(o.scene).duration;
   const int frames = static_cast<int>(std::lround(length * 60.0));
   SolverResult results[2];
@@ -233,6 +259,11 @@ int main(int argc, char** argv) {
     results[0].recorder.add(a.metrics);
     results[1].rows.push_back(b);
     results[1].recorder.add(b.metrics);
+    if (renderer) {
+      renderer->record(0, ours->cape(0), ours->bodyColliders(0));
+      twinMesh.update(twinRun.fabric(), twinRun.positions(0));
+      renderer->record(1, twinMesh, twinRun.bodyColliders(0));
+    }
     progress.update(f);
   }
   progress.finish();
@@ -296,6 +327,13 @@ int main(int argc, char** argv) {
   std::printf("settings:\n  ours:       %s\n  btSoftBody: %s\n", results[0].settings.dump().c_str(),
               results[1].settings.dump().c_str());
   std::ofstream(dir / "compare.json") << compare.dump(2) << "\n";
+  if (renderer) {
+    if (!renderer->finish(error)) {
+      std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
+      return 1;
+    }
+    std::printf("cape_compare: %d side-by-side frames rendered -> %s\n", renderer->frames(), render.c_str());
+  }
 
   if (!noPlots) {
     auto series = [&](auto value) {

@@ -56,6 +56,19 @@ TEST(CapeCompare, SimpleBodyAndNoPlots) {
   EXPECT_FALSE(fs::exists(dir / "strain.png"));
 }
 
+TEST(CapeCompare, RendersBothCapesSideBySide) {
+  const fs::path dir = freshDir();
+  const Result r = run(kCompare + " --size 8 --seconds 0.25 --no-plots --render " + (dir / "frames").string() +
+                       " --render-size 160x60 --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  int pngs = 0;
+  for (const auto& e : fs::directory_iterator(dir / "frames")) pngs += e.path().extension() == ".png" ? 1 : 0;
+  EXPECT_EQ(pngs, 15);
+  EXPECT_TRUE(isPng(dir / "frames" / "00015.png"));
+  const Result bad = run(kCompare + " --seconds 0.1 --render " + (dir / "x").string() + " --render-size big --out " + dir.string());
+  EXPECT_NE(bad.exitCode, 0);
+}
+
 TEST(CapeCompare, BadOptionsFailWithAReason) {
   const fs::path dir = freshDir();
   for (const std::string args : {"--scene dance", "--softbody-iterations 0", "--attach nose", "--urdf /nonexistent.urdf"}) {
