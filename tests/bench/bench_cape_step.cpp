@@ -46,6 +46,17 @@ void BM_WalkFrame4Substeps(benchmark::State& state) {
   s.substeps = 4;
   runFrames(state, SceneKind::Walk, s);
 }
+// Self-collision on (issue 6: at most twice the step without it), the walk and the sprint-turn.
+void BM_WalkFrameSelfCollision(benchmark::State& state) {
+  CapeSettings s = fixedSubsteps();
+  s.selfCollision = true;
+  runFrames(state, SceneKind::Walk, s);
+}
+void BM_SprintTurnFrameSelfCollision(benchmark::State& state) {
+  CapeSettings s;
+  s.selfCollision = true;
+  runFrames(state, SceneKind::SprintTurn, s);
+}
 void BM_SprintTurnFrame(benchmark::State& state) { runFrames(state, SceneKind::SprintTurn, CapeSettings()); }
 void BM_SprintTurnFrameFixed(benchmark::State& state) { runFrames(state, SceneKind::SprintTurn, fixedSubsteps()); }
 void BM_WalkFrameSeedExplicit(benchmark::State& state) {
@@ -60,6 +71,8 @@ void BM_WalkFrameSeedExplicit(benchmark::State& state) {
 BENCHMARK(BM_WalkFrame)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrameAdaptive)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrame4Substeps)->Arg(20)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WalkFrameSelfCollision)->Arg(20)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SprintTurnFrameSelfCollision)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SprintTurnFrame)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SprintTurnFrameFixed)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrameSeedExplicit)->Arg(20)->Unit(benchmark::kMicrosecond);

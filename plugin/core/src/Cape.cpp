@@ -84,10 +84,12 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   std::uint32_t buckets = 1;
   while (buckets < 2 * static_cast<std::uint32_t>(n)) buckets <<= 1;
   hashStart_.assign(buckets + 1, 0u);
-  hashEntries_.assign(8 * fabric_->triangleCount(), 0u);
+  hashEntries_.assign(8 * fabric_->triangleCount(), HashEntry{});
   triangleBoxes_.assign(8 * fabric_->triangleCount(), 0.0f);
   triangleStamp_.assign(fabric_->triangleCount(), 0u);
   largeTriangles_.reserve(fabric_->triangleCount());
+  triangleBuckets_.reserve(8 * fabric_->triangleCount());
+  triangleBucketStart_.assign(fabric_->triangleCount() + 1, 0u);
   stepMotion_ = Points::Zero(n, 3);
   stepMotionNorm_ = Eigen::VectorXf::Zero(n);
   selfWeight_ = Eigen::VectorXf::Zero(n);

@@ -124,8 +124,10 @@ void Cape::findSelfContacts(float dt) {
            cellOf(hi.z()) - cellOf(lo.z()) > kMaxSpan;
   };
   largeTriangles_.clear();
+  triangleBuckets_.clear();
   std::fill(hashStart_.begin(), hashStart_.end(), 0u);
   for (std::size_t t = 0; t < triangles; ++t) {
+    triangleBucketStart_[t] = static_cast<std::uint32_t>(triangleBuckets_.size());
     const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
     const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
     const float triMotion = std::max({motion[ia], motion[ib], motion[ic]});
@@ -145,34 +147,37 @@ void Cape::findSelfContacts(float dt) {
       largeTriangles_.push_back(static_cast<std::uint32_t>(t));
       continue;
     }
+    // The buckets of its cells, kept for the fill below (at most (kMaxSpan + 1)^3; usually 1 to 8).
     for (int ix = cellOf(lo.x()); ix <= cellOf(hi.x()); ++ix)
       for (int iy = cellOf(lo.y()); iy <= cellOf(hi.y()); ++iy)
-        for (int iz = cellOf(lo.z()); iz <= cellOf(hi.z()); ++iz) ++hashStart_[bucketOf(ix, iy, iz, mask) + 1];
+        for (int iz = cellOf(lo.z()); iz <= cellOf(hi.z()); ++iz) {
+          const std::uint32_t bucket = bucketOf(ix, iy, iz, mask);
+          ++hashStart_[bucket + 1];
+          triangleBuckets_.push_back(bucket);  // grows rarely: capacity kept between steps
+        }
   }
+  triangleBucketStart_[triangles] = static_cast<std::uint32_t>(triangleBuckets_.size());
   for (std::uint32_t b = 0; b < buckets; ++b) hashStart_[b + 1] += hashStart_[b];  // [b] = start of bucket b
   if (hashEntries_.size() < hashStart_[buckets]) hashEntries_.resize(hashStart_[buckets]);  // grows rarely
   // Fill in triangle order (deterministic), each bucket's start serving as its cursor...
   for (std::size_t t = 0; t < triangles; ++t) {
     const float* box = &triangleBoxes_[8 * t];
-    const Vec3 lo(box[0], box[1], box[2]), hi(box[3], box[4], box[5]);
-    if (spans(lo, hi)) continue;
-    for (int ix = cellOf(lo.x()); ix <= cellOf(hi.x()); ++ix)
-      for (int iy = cellOf(lo.y()); iy <= cellOf(hi.y()); ++iy)
-        for (int iz = cellOf(lo.z()); iz <= cellOf(hi.z()); ++iz)
-          hashEntries_[hashStart_[bucketOf(ix, iy, iz, mask)]++] = static_cast<std::uint32_t>(t);
+    const HashEntry entry{{box[0], box[1], box[2]}, {box[3], box[4], box[5]}, static_cast<std::uint32_t>(t)};
+    for (std::uint32_t k = triangleBucketStart_[t]; k < triangleBucketStart_[t + 1]; ++k)
+      hashEntries_[hashStart_[triangleBuckets_[k]]++] = entry;
   }
   // ...which leaves [b] at the end of bucket b: shift back so bucket b is [hashStart_[b], hashStart_[b + 1]).
   for (std::uint32_t b = buckets; b > 0; --b) hashStart_[b] = hashStart_[b - 1];
   hashStart_[0] = 0;
 
   // One particle against one triangle: the exact filter, and the contact with the side it is on.
-  auto consider = [&](std::uint32_t q, const Vec3& p, float mq, std::uint32_t t) {
+  auto consider = [&](std::uint32_t q, const Vec3& p, float mq, std::uint32_t t, const float* lo, const float* hi) {
+    if (p.x() + mq < lo[0] || p.y() + mq < lo[1] || p.z() + mq < lo[2] || p.x() - mq > hi[0] || p.y() - mq > hi[1] ||
+        p.z() - mq > hi[2])
+      return;
     if (triangleStamp_[t] == q) return;  // met already through another cell
     triangleStamp_[t] = q;
     const float* box = &triangleBoxes_[8 * t];
-    if (p.x() + mq < box[0] || p.y() + mq < box[1] || p.z() + mq < box[2] || p.x() - mq > box[3] || p.y() - mq > box[4] ||
-        p.z() - mq > box[5])
-      return;
     const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
     if (q == ia || q == ib || q == ic) return;
     // How much closer the two may come: the particle's motion relative to the triangle's corners.
@@ -200,16 +205,20 @@ void Cape::findSelfContacts(float dt) {
     const Vec3 p = at(x, q);
     const float mq = motion[q];
     if (spans(p.array() - mq, p.array() + mq)) {
-      for (std::size_t t = 0; t < triangles; ++t) consider(q, p, mq, static_cast<std::uint32_t>(t));
+      for (std::size_t t = 0; t < triangles; ++t)
+        consider(q, p, mq, static_cast<std::uint32_t>(t), &triangleBoxes_[8 * t], &triangleBoxes_[8 * t + 3]);
       continue;
     }
     for (int ix = cellOf(p.x() - mq); ix <= cellOf(p.x() + mq); ++ix)
       for (int iy = cellOf(p.y() - mq); iy <= cellOf(p.y() + mq); ++iy)
         for (int iz = cellOf(p.z() - mq); iz <= cellOf(p.z() + mq); ++iz) {
           const std::uint32_t bucket = bucketOf(ix, iy, iz, mask);
-          for (std::uint32_t e = hashStart_[bucket]; e < hashStart_[bucket + 1]; ++e) consider(q, p, mq, hashEntries_[e]);
+          for (std::uint32_t e = hashStart_[bucket]; e < hashStart_[bucket + 1]; ++e) {
+            const HashEntry& entry = hashEntries_[e];
+            consider(q, p, mq, entry.triangle, entry.lo, entry.hi);
+          }
         }
-    for (const std::uint32_t t : largeTriangles_) consider(q, p, mq, t);
+    for (const std::uint32_t t : largeTriangles_) consider(q, p, mq, t, &triangleBoxes_[8 * t], &triangleBoxes_[8 * t + 3]);
   }
 }
 

@@ -120,10 +120,19 @@ class Cape {
   };
   std::vector<SelfContact> selfContacts_;
   std::vector<std::uint32_t> hashStart_;     ///< Spatial hash: bucket offsets (buckets + 1).
-  std::vector<std::uint32_t> hashEntries_;   ///< Spatial hash: triangles sorted by bucket.
+  /// A triangle in a bucket of the spatial hash, with its grown box inline: the search reads entries in order
+  /// and rejects most by the box without touching the triangle.
+  struct HashEntry {
+    float lo[3];
+    float hi[3];
+    std::uint32_t triangle;
+  };
+  std::vector<HashEntry> hashEntries_;       ///< Spatial hash: triangles sorted by bucket.
   std::vector<float> triangleBoxes_;         ///< Per triangle: grown box (lo xyz, hi xyz), motion, radius, m.
   std::vector<std::uint32_t> triangleStamp_; ///< Last particle that met each triangle in the search.
   std::vector<std::uint32_t> largeTriangles_; ///< Triangles whose grown box is too big to bin.
+  std::vector<std::uint32_t> triangleBuckets_;     ///< The buckets each binned triangle went into...
+  std::vector<std::uint32_t> triangleBucketStart_; ///< ...from this offset per triangle (triangles + 1).
   Points stepMotion_;                        ///< Predicted displacement over the step, less the mean, m.
   Eigen::VectorXf selfWeight_;               ///< Inverse masses for the last self-contact pass, 1/kg.
   Eigen::VectorXf stepMotionNorm_;           ///< |stepMotion_| per particle, m.
