@@ -7,6 +7,7 @@
 #include "Progress.h"
 #include "Renderer.h"
 #include "RunOutput.h"
+#include "SceneOptions.h"
 
 #include "cape/bullet/CapeAction.h"
 #include "cape/bullet/Convert.h"
@@ -135,21 +136,12 @@ json twinSettingsJson(const bullet::SoftBodyTwinSettings& t) {
 int main(int argc, char** argv) {
   CLI::App app{"cape_compare: the same scene with our cape and with Bullet's btSoftBody twin, side by side; prints "
                "every metric of SCENARIOS.md per solver and writes compare.csv, compare.json and PNG plots."};
-  std::string scene = "walk", attachment = "corners", out, urdf, attach;
-  int size = 20, characters = 3, iterations = 10;
-  double seconds = -1.0;
-  bool simpleBody = false, noPlots = false;
+  SceneCli sceneCli;
+  std::string out;
+  int iterations = 10;
+  bool noPlots = false;
   std::string render, renderSize = "960x360";
-  app.add_option("--scene", scene, "hang | walk | sprint-turn | wind | crowd")
-      ->check(CLI::IsMember({"hang", "walk", "sprint-turn", "wind", "crowd"}))
-      ->capture_default_str();
-  app.add_option("--size", size, "particles per side of the N x N cape")->check(CLI::Range(2, 128))->capture_default_str();
-  app.add_option("--attachment", attachment, "corners | collar")->check(CLI::IsMember({"corners", "collar"}))->capture_default_str();
-  app.add_option("--seconds", seconds, "simulated length, s (default: the scene's own length)")->check(CLI::PositiveNumber);
-  app.add_option("--characters", characters, "characters in the crowd scene")->check(CLI::Range(1, 32))->capture_default_str();
-  app.add_flag("--simple-body", simpleBody, "the simple body of SCENARIOS.md instead of the shipped humanoid");
-  app.add_option("--urdf", urdf, "character URDF file (default: the shipped humanoid)")->check(CLI::ExistingFile);
-  app.add_option("--attach", attach, "comma-separated links the cape pins to (default: links named *shoulder*)");
+  addSceneOptions(app, sceneCli);
   app.add_option("--softbody-iterations", iterations, "btSoftBody position iterations (m_cfg.piterations)")
       ->check(CLI::Range(1, 200))
       ->capture_default_str();
@@ -161,21 +153,9 @@ int main(int argc, char** argv) {
   app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  RunOptions o;
-  parseSceneKind(scene, o.scene);
-  parseAttachment(attachment, o.attachment);
-  o.size = size;
-  o.seconds = seconds;
-  o.characters = o.scene == SceneKind::Crowd ? characters : 1;
-  o.simpleBody = simpleBody;
-  o.urdf = urdf;
-  for (std::size_t start = 0; !attach.empty();) {
-    const std::size_t comma = attach.find(',', start);
-    const std::string link = attach.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (!link.empty()) o.attachLinks.push_back(link);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
+  const RunOptions o = toRunOptions(sceneCli);
+  const std::string& scene = sceneCli.scene;
+  const int size = sceneCli.size;
 
   // The twin's settings: the same masses, springs (structural + shear, the King's graph; bend springs
   // soften btSoftBody's stretch resistance and are left out), friction, thickness and air drag as ours

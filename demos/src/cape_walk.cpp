@@ -5,6 +5,7 @@
 #include "Progress.h"
 #include "Renderer.h"
 #include "RunOutput.h"
+#include "SceneOptions.h"
 #include "SceneRun.h"
 
 #include <CLI/CLI.hpp>
@@ -40,53 +41,30 @@ nlohmann::json settingsJson(const CapeSettings& s) {
 int main(int argc, char** argv) {
   CLI::App app{"cape_walk: a character walks headlessly with a cape; writes metrics.csv, summary.json, "
                "frames/NNNNN.obj and colliders.jsonl to an output folder."};
-  std::string scene = "walk", attachment = "corners", solver = "xpbd", out, urdf, attach;
-  int size = 20, characters = 3, threads = 1, substeps = -1;
-  double seconds = -1.0;
-  bool noFrames = false, simpleBody = false, selfCollision = false;
-  app.add_option("--scene", scene, "hang | walk | sprint-turn | wind | crowd")
-      ->check(CLI::IsMember({"hang", "walk", "sprint-turn", "wind", "crowd"}))
-      ->capture_default_str();
-  app.add_option("--size", size, "particles per side of the N x N cape")->check(CLI::Range(2, 256))->capture_default_str();
-  app.add_option("--attachment", attachment, "corners (the two top corners) | collar (the whole top row)")
-      ->check(CLI::IsMember({"corners", "collar"}))
-      ->capture_default_str();
-  app.add_option("--seconds", seconds, "simulated length, s (default: the scene's own length)")
-      ->check(CLI::PositiveNumber);
+  SceneCli sceneCli;
+  std::string solver = "xpbd", out;
+  int threads = 1, substeps = -1;
+  bool noFrames = false, selfCollision = false;
+  addSceneOptions(app, sceneCli);
   app.add_option("--solver", solver, "xpbd (default) | explicit (the seed's explicit springs)")
       ->check(CLI::IsMember({"xpbd", "explicit"}))
       ->capture_default_str();
   app.add_option("--substeps", substeps, "solver substeps per 1/60 s frame (default: the solver's)")->check(CLI::Range(1, 64));
   app.add_flag("--self-collision", selfCollision, "keep the cape from passing through itself");
-  app.add_option("--characters", characters, "characters in the crowd scene")->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--threads", threads, "worker threads stepping the capes")->check(CLI::Range(1, 256))->capture_default_str();
   app.add_option("--out", out, "output folder (default: a fresh cape_run_<scene>_<time> folder)");
   app.add_flag("--no-frames", noFrames, "do not write frames/*.obj");
-  app.add_flag("--simple-body", simpleBody, "use the simple body of SCENARIOS.md instead of a URDF character");
-  app.add_option("--urdf", urdf, "character URDF file (default: the shipped humanoid)")->check(CLI::ExistingFile);
-  app.add_option("--attach", attach, "comma-separated links the cape pins to (default: links named *shoulder*)");
   std::string gltf, render, renderSize = "640x360";
   app.add_option("--gltf", gltf, "also write the run as an animated glTF 2.0 binary (.glb)");
   app.add_option("--render", render, "also render PNG frames (and run.mp4, run.gif with ffmpeg) into this folder");
   app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  RunOptions o;
-  parseSceneKind(scene, o.scene);
-  parseAttachment(attachment, o.attachment);
-  o.size = size;
-  o.seconds = seconds;
-  o.characters = o.scene == SceneKind::Crowd ? characters : 1;
+  RunOptions o = toRunOptions(sceneCli);
   o.threads = threads;
-  o.simpleBody = simpleBody;
-  o.urdf = urdf;
-  for (std::size_t start = 0; !attach.empty() && start <= attach.size();) {
-    const std::size_t comma = attach.find(',', start);
-    const std::string link = attach.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (!link.empty()) o.attachLinks.push_back(link);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
+  const std::string& scene = sceneCli.scene;
+  const std::string& attachment = sceneCli.attachment;
+  const int size = sceneCli.size;
   if (solver == "explicit") {
     o.settings = CapeSettings::seed();
     o.settings.timeStep = 1.0f / 60.0f;
