@@ -54,29 +54,6 @@ struct TriangleCollector : btTriangleCallback {
   }
 };
 
-/// Closest point of triangle abc to p (Ericson 2005, 5.1.5), and whether it lies inside the face.
-btVector3 closestOnTriangle(const btVector3& p, const btVector3& a, const btVector3& b, const btVector3& c,
-                            bool& onFace) {
-  onFace = false;
-  const btVector3 ab = b - a, ac = c - a, ap = p - a;
-  const btScalar d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const btVector3 bp = p - b;
-  const btScalar d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const btScalar vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-  const btVector3 cp = p - c;
-  const btScalar d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const btScalar vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-  const btScalar va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  onFace = true;
-  const btScalar denom = btScalar(1) / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
 
 }  // namespace
 
@@ -525,7 +502,7 @@ void CapeAction::concavePass(btScalar dt) {
         const btScalar side0 = n.dot(p0 - a);
         const btScalar side = side0 < 0 ? btScalar(-1) : btScalar(1);
         bool onFace = false;
-        const btVector3 q = closestOnTriangle(p, a, b, c, onFace);
+        const btVector3 q = closestOnTriangle(p, a, b, c, &onFace);
         if (onFace) {
           const btScalar d = side * n.dot(p - a);
           if (d < keep) {

@@ -2,6 +2,7 @@
 #include "cape/bullet/ShapeColliders.h"
 
 #include "cape/bullet/Convert.h"
+#include "cape/core/Geometry.h"
 
 #include <BulletCollision/CollisionShapes/btBoxShape.h>
 #include <BulletCollision/CollisionShapes/btCapsuleShape.h>
@@ -19,6 +20,13 @@
 #include <limits>
 
 namespace cape::bullet {
+
+btVector3 closestOnTriangle(const btVector3& p, const btVector3& a, const btVector3& b, const btVector3& c,
+                            bool* onFace) {
+  const TriangleNearest w = nearestOnTriangle(toVec3(p), toVec3(a), toVec3(b), toVec3(c));
+  if (onFace) *onFace = w.inFace;
+  return a * btScalar(w.wa) + b * btScalar(w.wb) + c * btScalar(w.wc);
+}
 
 namespace {
 
@@ -107,27 +115,6 @@ void convertInto(ShapeConversion& out, const btCollisionShape* shape, const btTr
   } else {
     out.unsupported.emplace_back(shape->getName());
   }
-}
-
-/// Closest point of triangle abc to p (Ericson, "Real-Time Collision Detection", 5.1.5: Voronoi regions).
-btVector3 closestOnTriangle(const btVector3& p, const btVector3& a, const btVector3& b, const btVector3& c) {
-  const btVector3 ab = b - a, ac = c - a, ap = p - a;
-  const btScalar d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const btVector3 bp = p - b;
-  const btScalar d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const btScalar vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-  const btVector3 cp = p - c;
-  const btScalar d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const btScalar vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-  const btScalar va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const btScalar denom = btScalar(1) / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
 struct NearestTriangle : btTriangleCallback {

@@ -5,50 +5,14 @@
 // the step free of intersections, no particle can pass through a triangle, however fast the fold.
 #include "cape/core/Cape.h"
 
+#include "cape/core/Geometry.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace cape {
 
 namespace {
-
-/// The point of triangle (a, b, c) nearest to p, as barycentric weights (wa, wb, wc), and whether it lies
-/// inside the face (true) or on its boundary. Voronoi regions of the triangle's vertices, edges and face.
-struct Nearest {
-  float wa, wb, wc;
-  bool inFace;
-};
-
-Nearest nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0f && d2 <= 0.0f) return {1, 0, 0, false};
-  const Vec3 bp = p - b;
-  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0f && d4 <= d3) return {0, 1, 0, false};
-  const float vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
-    const float v = d1 / (d1 - d3);
-    return {1 - v, v, 0, false};
-  }
-  const Vec3 cp = p - c;
-  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0f && d5 <= d6) return {0, 0, 1, false};
-  const float vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
-    const float w = d2 / (d2 - d6);
-    return {1 - w, 0, w, false};
-  }
-  const float va = d3 * d6 - d5 * d4;
-  if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
-    const float w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return {0, 1 - w, w, false};
-  }
-  const float denom = va + vb + vc;
-  if (!(std::fabs(denom) > 0.0f)) return {1, 0, 0, false};  // degenerate triangle: treat as its first corner
-  const float v = vb / denom, w = vc / denom;
-  return {1 - v - w, v, w, true};
-}
 
 /// Barycentric weights of p's projection onto the plane of (a, b, c), unclamped; false if degenerate.
 bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float& wa, float& wb, float& wc) {
@@ -190,7 +154,7 @@ void Cape::findSelfContacts(float dt) {
     const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
     const float reach = within + box[7];
     if ((p - (a + b + c) / 3.0f).squaredNorm() > reach * reach) return;
-    const Nearest w = nearestOnTriangle(p, a, b, c);
+    const TriangleNearest w = nearestOnTriangle(p, a, b, c);
     const Vec3 nearest = w.wa * a + w.wb * b + w.wc * c;
     if ((p - nearest).squaredNorm() > within * within) return;
     float side = 0.0f, wa, wb, wc;
@@ -229,7 +193,7 @@ void Cape::solveSelfContacts(const float* w) {
   for (SelfContact& k : selfContacts_) {
     const std::uint32_t ia = tri[3 * k.triangle], ib = tri[3 * k.triangle + 1], ic = tri[3 * k.triangle + 2];
     const Vec3 p = at(x, k.particle), a = at(x, ia), b = at(x, ib), c = at(x, ic);
-    const Nearest bary = nearestOnTriangle(p, a, b, c);
+    const TriangleNearest bary = nearestOnTriangle(p, a, b, c);
     Vec3 normal;
     float distance;
     float wa, wb, wc;

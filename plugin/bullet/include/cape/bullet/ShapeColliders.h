@@ -58,4 +58,9 @@ bool convexSignedDistance(const btConvexShape* shape, const btTransform& world, 
 /// Returns +infinity for shapes it cannot measure.
 btScalar shapeSignedDistance(const btCollisionShape* shape, const btTransform& world, const btVector3& point);
 
+/// The point of triangle abc nearest to p (cape::nearestOnTriangle in Bullet's types); `onFace`, when given,
+/// says whether it lies inside the face rather than on an edge or a corner.
+btVector3 closestOnTriangle(const btVector3& p, const btVector3& a, const btVector3& b, const btVector3& c,
+                            bool* onFace = nullptr);
+
 }  // namespace cape::bullet
