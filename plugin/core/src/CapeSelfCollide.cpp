@@ -43,13 +43,19 @@ inline std::uint32_t bucketOf(int ix, int iy, int iz, std::uint32_t mask) {
 
 }  // namespace
 
+float Cape::selfThickness() const {
+  // As set, or 0.35 of the mean spacing (CapeSettings::selfCollisionThickness explains the measurement).
+  constexpr float kAutoThickness = 0.35f;
+  return settings_.selfCollisionThickness > 0.0f ? settings_.selfCollisionThickness : kAutoThickness * meanSpacing_;
+}
+
 void Cape::findSelfContacts(float dt) {
   selfContacts_.clear();
   const Points& x = state_.positions;
   // A cape that is no longer finite has blown up (the metrics report it); there is nothing to keep apart.
   if (!x.allFinite() || !state_.velocities.allFinite()) return;
   const Eigen::Index n = x.rows();
-  const float thickness = settings_.selfCollisionThickness;
+  const float thickness = selfThickness();
 
   // How far each particle may move in this step, less the motion the whole cape shares (walking carries
   // every particle 2 cm per frame, which brings no two of them closer): v dt + g dt^2 / 2 (pinned particles
@@ -62,8 +68,8 @@ void Cape::findSelfContacts(float dt) {
   motion = stepMotion_.rowwise().norm();  // same size every step: no allocation
 
   // A pair can close in by at most their relative motion; the solver's own corrections (springs, collisions)
-  // add some more, which one more thickness and a quarter of the spacing allow for.
-  const float slack = thickness + 0.25f * meanSpacing_;
+  // add some more, which a quarter of the spacing allows for.
+  const float slack = 0.25f * meanSpacing_;
 
   // Bin the triangles, each grown by the thickness, the slack and its own motion, into the cells of a hashed
   // grid; each particle then visits the cells of its own motion's box. Cells twice the spacing: a triangle
@@ -188,7 +194,9 @@ void Cape::findSelfContacts(float dt) {
 
 void Cape::solveSelfContacts(const float* w) {
   Points& x = state_.positions;
-  const float thickness = settings_.selfCollisionThickness;
+  const float thickness = selfThickness();
+  // The deepest a particle can have crossed within one step and still be brought back: half the spacing.
+  const float maxCrossing = 0.5f * meanSpacing_;
   const std::vector<std::uint32_t>& tri = fabric_->triangles();
   for (SelfContact& k : selfContacts_) {
     const std::uint32_t ia = tri[3 * k.triangle], ib = tri[3 * k.triangle + 1], ic = tri[3 * k.triangle + 2];
@@ -206,6 +214,10 @@ void Cape::solveSelfContacts(const float* w) {
       if (k.side == 0.0f) k.side = faceNormal.dot(p - a) >= 0.0f ? 1.0f : -1.0f;
       normal = k.side * faceNormal;
       distance = normal.dot(p - a);  // negative: it has crossed, and is brought back
+      // Far on the other side is not a crossing within this step (the region over a face reaches out along
+      // its normal without end, and a triangle that turns over carries its side with it): pulling such a
+      // particle back through the cloth would throw it across the cape, so the pair is let go.
+      if (distance < -maxCrossing) continue;
       // The correction goes to the corners by the weights of the nearest point of the real triangle.
     } else {
       // Beside an edge or a corner: a plain distance, no side to keep.

@@ -48,8 +48,8 @@ Status CapeSettings::validate() const {
   if (!finiteNonNegative(collisionThickness))
     return Status::error("CapeSettings: collisionThickness must be finite and >= 0 (m)");
   if (!finiteNonNegative(friction)) return Status::error("CapeSettings: friction must be finite and >= 0");
-  if (selfCollision && !(std::isfinite(selfCollisionThickness) && selfCollisionThickness > 0.0f))
-    return Status::error("CapeSettings: selfCollisionThickness must be finite and > 0 (m)");
+  if (!(std::isfinite(selfCollisionThickness) && selfCollisionThickness >= 0.0f))
+    return Status::error("CapeSettings: selfCollisionThickness must be finite and >= 0 (m; 0 = automatic)");
   if (substeps < 1 || substeps > 1000) return Status::error("CapeSettings: substeps must be in 1..1000");
   if (!(std::isfinite(strainLimit) && strainLimit >= 0.0f)) return Status::error("CapeSettings: strainLimit must be finite and >= 0");
   if (maxRefinement < 1 || maxRefinement > 64) return Status::error("CapeSettings: maxRefinement must be in 1..64");

@@ -69,6 +69,8 @@ class Cape {
   int substepRefinement() const { return refinement_; }
   float lastMaxStrain() const { return lastMaxStrain_; }
 
+  /// The self-collision thickness in use, m (the setting, or its automatic value).
+  float selfCollisionThickness() const { return selfThickness(); }
   /// Self-contacts found for the last step (diagnostics and benchmarks).
   std::size_t selfContactCount() const { return selfContacts_.size(); }
 
@@ -88,6 +90,7 @@ class Cape {
   void accumulateExternalAcceleration();
   void findSelfContacts(float dt);
   void solveSelfContacts(const float* inverseMasses);
+  float selfThickness() const;
 
   FabricPtr fabric_;
   CapeSettings settings_;

@@ -76,9 +76,12 @@ struct CapeSettings {
   /// Keep the cape from passing through itself: particle-triangle contacts found through a spatial hash at
   /// the start of every step and kept on their side through its substeps (predictive contacts, Lewin 2018).
   bool selfCollision = false;
-  /// Distance kept between a particle and any triangle it does not belong to, m (> 0 when self-collision is
-  /// on). About the cloth's real thickness; well under the particle spacing.
-  float selfCollisionThickness = 0.005f;
+  /// Distance kept between a particle and any triangle it does not belong to, m; 0 (the default) chooses 0.35
+  /// of the mean particle spacing (1.3 cm on the canonical 20 x 20 cape). Measured on the 20 x 20 cape: at
+  /// 5 mm the sprint-turn still had 24 intersecting triangle pairs in its worst frame (two layers crossing
+  /// edge through edge between their particles); from about a third of the spacing none, in every scene.
+  /// Keep it well under the spacing, or neighbours of the same layer push each other.
+  float selfCollisionThickness = 0.0f;
 
   /// The seed's reference set-up: explicit springs, soft, 4 substeps of 0.00875 s per 0.035 s frame.
   static CapeSettings seed();
