@@ -122,6 +122,7 @@ class Cape {
     float side;
   };
   std::vector<SelfContact> selfContacts_;
+  double selfContactsValidUntil_ = -1.0;     ///< s: the contacts cover the motion until this time.
   std::vector<std::uint32_t> hashStart_;     ///< Spatial hash: bucket offsets (buckets + 1).
   /// A triangle in a bucket of the spatial hash, with its grown box inline: the search reads entries in order
   /// and rejects most by the box without touching the triangle.
