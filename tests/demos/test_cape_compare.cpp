@@ -2,6 +2,8 @@
 // per solver (ours first) with every metric, compare.csv the same rows, and the plots are PNG files.
 #include "DemoTestSupport.h"
 
+#include <nlohmann/json.hpp>
+
 namespace cape::demo_test {
 namespace {
 

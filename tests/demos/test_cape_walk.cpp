@@ -3,6 +3,8 @@
 // fail with a non-zero exit and a one-line reason.
 #include "DemoTestSupport.h"
 
+#include <nlohmann/json.hpp>
+
 namespace cape::demo_test {
 namespace {
 

@@ -1,5 +1,7 @@
 // cape_walk's --gltf and --render end to end: a short simple-body walk exports a .glb that loads back and
 // renders frames of the requested size; bad paths and sizes fail with a one-line reason.
+#include "DemoTestSupport.h"
+
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 
@@ -13,31 +15,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int exitCode = -1;
-  std::string output;  ///< stdout and stderr together
-};
+using cape::demo_test::freshDir;
+using cape::demo_test::Result;
 
-Result runWalk(const std::string& arguments) {
-  Result r;
-  std::FILE* p = popen((std::string(CAPE_WALK) + " " + arguments + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, p)) > 0) r.output.append(buffer, n);
-  const int status = pclose(p);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-fs::path freshDir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir =
-      fs::temp_directory_path() / ("cape_visuals_" + std::to_string(::getpid())) / info->name();
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+Result runWalk(const std::string& arguments) { return cape::demo_test::run(std::string(CAPE_WALK) + " " + arguments); }
 
 /// Width and height from a PNG's IHDR chunk.
 bool pngSize(const fs::path& file, unsigned& width, unsigned& height) {
