@@ -5,8 +5,6 @@
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
 #include <cstdio>
 #include <filesystem>
 #include <string>
