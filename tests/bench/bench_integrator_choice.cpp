@@ -136,9 +136,11 @@ void reportStrain(benchmark::State& state, const MetricsRecorder& rec) {
   state.counters["strain_p95_pct"] = 100.0 * r.p95FrameMaxStrain;
 }
 
-// XPBD: the core as shipped; range(0) = substeps, range(1) = tethers on/off.
+// XPBD: the core as shipped; range(0) = substeps, range(1) = tethers on/off. Fixed substeps (no strain-
+// adaptive refinement), so that each row measures the substep count it names.
 void BM_WalkPinsXpbd(benchmark::State& state) {
   CapeSettings s;
+  s.strainLimit = 0.0f;
   s.substeps = static_cast<int>(state.range(0));
   s.useTethers = state.range(1) != 0;
   const MotionDesc motion = MotionDesc::forScene(SceneKind::Walk);
