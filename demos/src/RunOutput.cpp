@@ -14,6 +14,34 @@ json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 const char* axisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
 }  // namespace
 
+json settingsJson(const CapeSettings& s) {
+  json wind = {{"model", s.wind.model == WindSettings::Model::None       ? "none"
+                         : s.wind.model == WindSettings::Model::SineWave ? "sine-wave"
+                                                                          : "aerodynamic"}};
+  if (s.wind.model != WindSettings::Model::None)
+    wind.update({{"direction", vec(s.wind.direction)}, {"speed_mps", s.wind.speed}, {"gust_amplitude", s.wind.gustAmplitude},
+                 {"gust_frequency_hz", s.wind.gustFrequency}, {"turbulence_scale_m", s.wind.turbulenceScale},
+                 {"drag_coefficient", s.wind.dragCoefficient}, {"lift_coefficient", s.wind.liftCoefficient},
+                 {"seed", s.wind.seed}});
+  return {{"integrator", toString(s.integrator)},
+          {"structural_stiffness_n_per_m", s.structuralStiffness},
+          {"shear_stiffness_n_per_m", s.shearStiffness},
+          {"bend_stiffness_n_per_m", s.bendStiffness},
+          {"tethers", s.useTethers},
+          {"damping_per_s", s.damping},
+          {"collision_thickness_m", s.collisionThickness},
+          {"friction", s.friction},
+          {"substeps_per_time_step", s.substeps},
+          {"time_step_s", s.timeStep},
+          {"strain_limit", s.strainLimit},
+          {"max_refinement", s.maxRefinement},
+          {"iterations", s.iterations},
+          {"gravity", vec(s.gravity)},
+          {"wind", wind},
+          {"self_collision", s.selfCollision},
+          {"self_collision_thickness_m", s.selfCollisionThickness}};
+}
+
 json colliderJson(const Collider& c) {
   json j;
   j["name"] = c.name;

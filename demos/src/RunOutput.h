@@ -26,6 +26,9 @@ struct FrameRow {
   FrameMetrics metrics;
 };
 
+/// The cape's settings as written to summary.json and compare.json (units in the key names).
+nlohmann::json settingsJson(const CapeSettings& settings);
+
 /// The JSON description of a collider at its current pose (the colliders.jsonl schema).
 nlohmann::json colliderJson(const Collider& collider);
 

@@ -115,13 +115,6 @@ class TwinRun {
   std::vector<SelfIntersectionCounter> counters_;
 };
 
-json capeSettingsJson(const CapeSettings& s) {
-  return {{"integrator", toString(s.integrator)}, {"substeps_per_frame", s.substeps}, {"iterations", s.iterations},
-          {"structural_stiffness_n_per_m", s.structuralStiffness}, {"shear_stiffness_n_per_m", s.shearStiffness},
-          {"bend_stiffness_n_per_m", s.bendStiffness}, {"tethers", s.useTethers}, {"damping_per_s", s.damping},
-          {"collision_thickness_m", s.collisionThickness}, {"friction", s.friction},
-          {"self_collision", s.selfCollision}};
-}
 
 json twinSettingsJson(const bullet::SoftBodyTwinSettings& t) {
   return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") + (t.bendLinks ? "bend" : "")},
@@ -218,7 +211,7 @@ int main(int argc, char** argv) {
   const int frames = static_cast<int>(std::lround(length * 60.0));
   SolverResult results[2];
   results[0].name = "ours (XPBD cape)";
-  results[0].settings = capeSettingsJson(settingsForScene(o.scene, o.settings));
+  results[0].settings = settingsJson(settingsForScene(o.scene, o.settings));
   results[1].name = "btSoftBody twin";
   results[1].settings = twinSettingsJson(twin);
   std::vector<SelfIntersectionCounter> counters(static_cast<std::size_t>(ours->characterCount()));

@@ -21,20 +21,6 @@ using namespace cape::demo;
 
 namespace {
 
-nlohmann::json settingsJson(const CapeSettings& s) {
-  return {{"integrator", toString(s.integrator)},
-          {"structural_stiffness_n_per_m", s.structuralStiffness},
-          {"shear_stiffness_n_per_m", s.shearStiffness},
-          {"bend_stiffness_n_per_m", s.bendStiffness},
-          {"tethers", s.useTethers},
-          {"damping_per_s", s.damping},
-          {"collision_thickness_m", s.collisionThickness},
-          {"friction", s.friction},
-          {"substeps", s.substeps},
-          {"iterations", s.iterations},
-          {"gravity", {s.gravity.x(), s.gravity.y(), s.gravity.z()}},
-          {"self_collision", s.selfCollision}};
-}
 
 }  // namespace
 
@@ -187,7 +173,7 @@ int main(int argc, char** argv) {
   summary["cape"] = {{"width_m", 0.6}, {"height_m", 1.0}, {"mass_kg", run->cape(0).fabric().totalMass()}};
   summary["frame_time_s"] = 1.0 / 60.0;
   summary["seconds"] = length;
-  summary["settings"] = settingsJson(o.settings);
+  summary["settings"] = settingsJson(settingsForScene(o.scene, o.settings));
   summary["summary"] = summaryFigures(rows, q);
   if (run->characterCount() > 1) {
     for (std::size_t k = 0; k < recorders.size(); ++k) {
