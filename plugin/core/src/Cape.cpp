@@ -85,11 +85,61 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   while (buckets < 2 * static_cast<std::uint32_t>(n)) buckets <<= 1;
   hashStart_.assign(buckets + 1, 0u);
   hashEntries_.assign(8 * fabric_->triangleCount(), HashEntry{});
+  bucketHits_.assign(hashEntries_.size(), 0u);
   triangleBoxes_.assign(8 * fabric_->triangleCount(), 0.0f);
+  {
+    // The far corners across each triangle's edges: sort the edges (as vertex pairs) to meet each one's
+    // two triangles. An edge of more than two triangles (a non-manifold mesh) gets no wings.
+    struct HalfEdge {
+      std::uint64_t key;
+      std::uint32_t slot;  // 3 * triangle + edge
+      std::uint32_t far;
+    };
+    std::vector<HalfEdge> edges;
+    edges.reserve(tri.size());
+    for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::uint32_t u = tri[t + k], v = tri[t + (k + 1) % 3], far = tri[t + (k + 2) % 3];
+        const std::uint64_t key = (static_cast<std::uint64_t>(std::min(u, v)) << 32) | std::max(u, v);
+        edges.push_back({key, static_cast<std::uint32_t>(t + k), far});
+      }
+    }
+    std::sort(edges.begin(), edges.end(), [](const HalfEdge& a, const HalfEdge& b) {
+      return a.key != b.key ? a.key < b.key : a.slot < b.slot;
+    });
+    LocalSet none;
+    std::fill(std::begin(none.v), std::end(none.v), ~0u);
+    triangleLocal_.assign(fabric_->triangleCount(), none);
+    for (std::size_t t = 0; t < triangleLocal_.size(); ++t)
+      for (std::size_t k = 0; k < 3; ++k) triangleLocal_[t].v[k] = tri[3 * t + k];
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i;
+      while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+      if (j - i == 2) {  // slot = 3 * triangle + edge: the wing goes to v[3 + edge]
+        triangleLocal_[edges[i].slot / 3].v[3 + edges[i].slot % 3] = edges[i + 1].far;
+        triangleLocal_[edges[i + 1].slot / 3].v[3 + edges[i + 1].slot % 3] = edges[i].far;
+      }
+      i = j;
+    }
+  }
   triangleStamp_.assign(fabric_->triangleCount(), 0u);
   largeTriangles_.reserve(fabric_->triangleCount());
   triangleBuckets_.reserve(8 * fabric_->triangleCount());
-  triangleBucketStart_.assign(fabric_->triangleCount() + 1, 0u);
+  // Clusters: consecutive triangles that share an edge go in pairs (a grid's cells come out as pairs).
+  clusterStart_.assign(1, 0u);
+  for (std::size_t t = 0; t < fabric_->triangleCount();) {
+    std::size_t next = t + 1;
+    if (next < fabric_->triangleCount()) {
+      int shared = 0;
+      for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) shared += tri[3 * t + i] == tri[3 * next + j] ? 1 : 0;
+      if (shared == 2) ++next;
+    }
+    clusterStart_.push_back(static_cast<std::uint32_t>(next));
+    t = next;
+  }
+  clusterBoxes_.assign(6 * (clusterStart_.size() - 1), 0.0f);
+  triangleBucketStart_.assign(clusterStart_.size(), 0u);
   stepMotion_ = Points::Zero(n, 3);
   stepMotionNorm_ = Eigen::VectorXf::Zero(n);
   selfWeight_ = Eigen::VectorXf::Zero(n);
@@ -192,7 +242,10 @@ void Cape::step(float dt, ColliderSpan colliders) {
   // Self-contacts are found from where the cape is now and kept through the substeps. When the cape moves
   // calmly (no particle faster than half a spacing per settings.timeStep relative to the cape as a whole),
   // one search covers a whole timeStep: a world stepping at 1/240 s then searches once per 1/60 s, with that
-  // 1/60 s's motion bound. Otherwise every step searches for itself.
+  // 1/60 s's motion bound. A faster cape searches again every few substeps, so that no particle moves more
+  // than half a spacing between searches: a search over a whole fast frame would pair every particle with
+  // every triangle it might sweep past, and the substeps would carry thousands of contacts.
+  int searchEvery = 0;  // substeps between searches; 0: the contacts found earlier still cover this step
   if (settings_.selfCollision && settings_.integrator == Integrator::Xpbd &&
       state_.time + static_cast<double>(dt) > selfContactsValidUntil_ + 1e-9) {
     const Eigen::RowVector3f mean = state_.velocities.colwise().mean();
@@ -200,11 +253,24 @@ void Cape::step(float dt, ColliderSpan colliders) {
     for (Eigen::Index i = 0; i < state_.velocities.rows(); ++i)
       fastest2 = std::max(fastest2, (state_.velocities.row(i) - mean).squaredNorm());
     const float fastest = std::sqrt(fastest2);
-    const float window = fastest * settings_.timeStep < 0.5f * meanSpacing_ ? std::max(dt, settings_.timeStep) : dt;
-    findSelfContacts(window);
-    selfContactsValidUntil_ = state_.time + static_cast<double>(window);
+    const float calmMotion = 0.5f * meanSpacing_;
+    constexpr float kSearchMotion = 1.0f;
+    if (fastest * settings_.timeStep < calmMotion) {
+      const float window = std::max(dt, settings_.timeStep);
+      findSelfContacts(window);
+      ++selfSearches_;
+      selfContactsValidUntil_ = state_.time + static_cast<double>(window);
+    } else {
+      const float searches = std::min(static_cast<float>(substeps), std::ceil(fastest * dt / (kSearchMotion * meanSpacing_)));
+      searchEvery = static_cast<int>(std::ceil(static_cast<float>(substeps) / std::max(searches, 1.0f)));
+      selfContactsValidUntil_ = state_.time + static_cast<double>(dt);
+    }
   }
   for (int k = 0; k < substeps; ++k) {
+    if (searchEvery > 0 && k % searchEvery == 0) {
+      findSelfContacts(h * static_cast<float>(std::min(searchEvery, substeps - k)));
+      ++selfSearches_;
+    }
     const float s0 = static_cast<float>(k) / static_cast<float>(substeps);
     const float s1 = static_cast<float>(k + 1) / static_cast<float>(substeps);
     if (settings_.integrator == Integrator::Xpbd)

@@ -9,6 +9,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace cape {
 
@@ -34,6 +39,19 @@ constexpr float kFaceMargin = 0.25f;
 inline bool overFace(float wa, float wb, float wc) { return wa >= -kFaceMargin && wb >= -kFaceMargin && wc >= -kFaceMargin; }
 
 inline Vec3 at(const Points& x, std::uint32_t i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
+
+// A hash entry keeps its triangle's index in the unused fourth lane of the box's low corner, as the bits of
+// a float that every comparison below passes (at most 2^25 triangles: a positive finite float).
+inline float indexBits(std::uint32_t i) {
+  float f;
+  std::memcpy(&f, &i, sizeof f);
+  return f;
+}
+inline std::uint32_t bitsIndex(float f) {
+  std::uint32_t i;
+  std::memcpy(&i, &f, sizeof i);
+  return i;
+}
 
 inline std::uint32_t bucketOf(int ix, int iy, int iz, std::uint32_t mask) {
   const std::uint32_t h = static_cast<std::uint32_t>(ix) * 73856093u ^ static_cast<std::uint32_t>(iy) * 19349663u ^
@@ -96,25 +114,37 @@ void Cape::findSelfContacts(float dt) {
   largeTriangles_.clear();
   triangleBuckets_.clear();
   std::fill(hashStart_.begin(), hashStart_.end(), 0u);
-  for (std::size_t t = 0; t < triangles; ++t) {
-    triangleBucketStart_[t] = static_cast<std::uint32_t>(triangleBuckets_.size());
-    const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
-    const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
-    const float triMotion = std::max({motion[ia], motion[ib], motion[ic]});
-    const float grow = thickness + slack + triMotion;
-    const Vec3 lo = a.cwiseMin(b).cwiseMin(c).array() - grow;
-    const Vec3 hi = a.cwiseMax(b).cwiseMax(c).array() + grow;
-    float* box = &triangleBoxes_[8 * t];
-    for (int k = 0; k < 3; ++k) {
-      box[k] = lo[k];
-      box[3 + k] = hi[k];
+  // Binned by cluster (the two triangles of a grid cell share its box): half the entries of binning each.
+  const std::size_t clusters = clusterStart_.size() - 1;
+  for (std::size_t g = 0; g < clusters; ++g) {
+    triangleBucketStart_[g] = static_cast<std::uint32_t>(triangleBuckets_.size());
+    Vec3 lo = Vec3::Constant(std::numeric_limits<float>::max()), hi = -lo;
+    for (std::uint32_t t = clusterStart_[g]; t < clusterStart_[g + 1]; ++t) {
+      const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
+      const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
+      const float triMotion = std::max({motion[ia], motion[ib], motion[ic]});
+      const float grow = thickness + slack + triMotion;
+      const Vec3 tlo = a.cwiseMin(b).cwiseMin(c).array() - grow;
+      const Vec3 thi = a.cwiseMax(b).cwiseMax(c).array() + grow;
+      float* box = &triangleBoxes_[8 * t];
+      for (int k = 0; k < 3; ++k) {
+        box[k] = tlo[k];
+        box[3 + k] = thi[k];
+      }
+      // A bounding sphere for a quick rejection: about the centroid, out to the farthest corner.
+      const Vec3 centroid = (a + b + c) / 3.0f;
+      box[6] = triMotion;
+      box[7] = std::sqrt(std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()}));
+      lo = lo.cwiseMin(tlo);
+      hi = hi.cwiseMax(thi);
     }
-    // A bounding sphere for a quick rejection: about the centroid, out to the farthest corner.
-    const Vec3 centroid = (a + b + c) / 3.0f;
-    box[6] = triMotion;
-    box[7] = std::sqrt(std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()}));
+    float* clusterBox = &clusterBoxes_[6 * g];
+    for (int k = 0; k < 3; ++k) {
+      clusterBox[k] = lo[k];
+      clusterBox[3 + k] = hi[k];
+    }
     if (spans(lo, hi)) {
-      largeTriangles_.push_back(static_cast<std::uint32_t>(t));
+      for (std::uint32_t t = clusterStart_[g]; t < clusterStart_[g + 1]; ++t) largeTriangles_.push_back(t);
       continue;
     }
     // The buckets of its cells, kept for the fill below (at most (kMaxSpan + 1)^3; usually 1 to 8).
@@ -122,34 +152,58 @@ void Cape::findSelfContacts(float dt) {
       for (int iy = cellOf(lo.y()); iy <= cellOf(hi.y()); ++iy)
         for (int iz = cellOf(lo.z()); iz <= cellOf(hi.z()); ++iz) {
           const std::uint32_t bucket = bucketOf(ix, iy, iz, mask);
+          // Once per bucket, even if two of its cells hash to the same one: a particle that visits a single
+          // cell then meets each triangle at most once, and needs no stamps.
+          const auto first = triangleBuckets_.begin() + triangleBucketStart_[g];
+          if (std::find(first, triangleBuckets_.end(), bucket) != triangleBuckets_.end()) continue;
           ++hashStart_[bucket + 1];
           triangleBuckets_.push_back(bucket);  // grows rarely: capacity kept between steps
         }
   }
-  triangleBucketStart_[triangles] = static_cast<std::uint32_t>(triangleBuckets_.size());
+  triangleBucketStart_[clusters] = static_cast<std::uint32_t>(triangleBuckets_.size());
   for (std::uint32_t b = 0; b < buckets; ++b) hashStart_[b + 1] += hashStart_[b];  // [b] = start of bucket b
-  if (hashEntries_.size() < hashStart_[buckets]) hashEntries_.resize(hashStart_[buckets]);  // grows rarely
-  // Fill in triangle order (deterministic), each bucket's start serving as its cursor...
-  for (std::size_t t = 0; t < triangles; ++t) {
-    const float* box = &triangleBoxes_[8 * t];
-    const HashEntry entry{{box[0], box[1], box[2]}, {box[3], box[4], box[5]}, static_cast<std::uint32_t>(t)};
-    for (std::uint32_t k = triangleBucketStart_[t]; k < triangleBucketStart_[t + 1]; ++k)
+  if (hashEntries_.size() < hashStart_[buckets]) {  // grows rarely
+    hashEntries_.resize(hashStart_[buckets]);
+    bucketHits_.resize(hashStart_[buckets]);
+  }
+  // Fill in cluster order (deterministic), each bucket's start serving as its cursor...
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (std::size_t g = 0; g < clusters; ++g) {
+    const float* box = &clusterBoxes_[6 * g];
+    const HashEntry entry{{box[0], box[1], box[2], indexBits(static_cast<std::uint32_t>(g))}, {box[3], box[4], box[5], kInf}};
+    for (std::uint32_t k = triangleBucketStart_[g]; k < triangleBucketStart_[g + 1]; ++k)
       hashEntries_[hashStart_[triangleBuckets_[k]]++] = entry;
   }
   // ...which leaves [b] at the end of bucket b: shift back so bucket b is [hashStart_[b], hashStart_[b + 1]).
   for (std::uint32_t b = buckets; b > 0; --b) hashStart_[b] = hashStart_[b - 1];
   hashStart_[0] = 0;
 
-  // One particle against one triangle: the exact filter, and the contact with the side it is on.
-  auto consider = [&](std::uint32_t q, const Vec3& p, float mq, std::uint32_t t, const float* lo, const float* hi) {
-    if (p.x() + mq < lo[0] || p.y() + mq < lo[1] || p.z() + mq < lo[2] || p.x() - mq > hi[0] || p.y() - mq > hi[1] ||
-        p.z() - mq > hi[2])
-      return;
-    if (triangleStamp_[t] == q) return;  // met already through another cell
-    triangleStamp_[t] = q;
+  // One particle against one triangle whose grown box its motion's box overlaps: the exact filter, and the
+  // contact with the side it is on.
+  // Its own triangles, and those it is the far corner of across an edge (the other half of a grid cell):
+  // it reaches such a triangle only by folding that edge's hinge flat, which the spring between the two
+  // far corners (a shear or bend spring) resists, and the two triangles share an edge, so the hinge cannot
+  // make a self-intersecting pair. At rest the other half of a grid cell is 0.71 spacings away, within the
+  // search's reach: these were most of the exact tests. triangleLocal_ holds the six of each triangle.
+  auto local = [this](std::uint32_t q, std::uint32_t t) {
+    const std::uint32_t* v = triangleLocal_[t].v;
+#if defined(__SSE2__)
+    const __m128i key = _mm_set1_epi32(static_cast<int>(q));
+    const __m128i lo = _mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(v)), key);
+    const __m128i hi = _mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(v + 4)), key);
+    return _mm_movemask_epi8(_mm_or_si128(lo, hi)) != 0;
+#else
+    return (q == v[0]) | (q == v[1]) | (q == v[2]) | (q == v[3]) | (q == v[4]) | (q == v[5]);
+#endif
+  };
+  auto consider = [&](std::uint32_t q, const Vec3& p, std::uint32_t t, bool stamp) {
+    if (local(q, t)) return;
+    if (stamp) {
+      if (triangleStamp_[t] == q) return;  // met already through another cell
+      triangleStamp_[t] = q;
+    }
     const float* box = &triangleBoxes_[8 * t];
     const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
-    if (q == ia || q == ib || q == ic) return;
     // How much closer the two may come: the particle's motion relative to the triangle's corners.
     const Vec3 mqv = stepMotion_.row(q).transpose();
     const float closing = std::sqrt(std::max({(mqv - stepMotion_.row(ia).transpose()).squaredNorm(),
@@ -174,21 +228,48 @@ void Cape::findSelfContacts(float dt) {
     const std::uint32_t q = static_cast<std::uint32_t>(qi);
     const Vec3 p = at(x, q);
     const float mq = motion[q];
+    const float lx = p.x() - mq, ly = p.y() - mq, lz = p.z() - mq, hx = p.x() + mq, hy = p.y() + mq, hz = p.z() + mq;
+    auto overlaps = [&](const float* lo, const float* hi) {
+      return (hx >= lo[0]) & (hy >= lo[1]) & (hz >= lo[2]) & (lx <= hi[0]) & (ly <= hi[1]) & (lz <= hi[2]);
+    };
     if (spans(p.array() - mq, p.array() + mq)) {
       for (std::size_t t = 0; t < triangles; ++t)
-        consider(q, p, mq, static_cast<std::uint32_t>(t), &triangleBoxes_[8 * t], &triangleBoxes_[8 * t + 3]);
+        if (overlaps(&triangleBoxes_[8 * t], &triangleBoxes_[8 * t + 3])) consider(q, p, static_cast<std::uint32_t>(t), false);
       continue;
     }
-    for (int ix = cellOf(p.x() - mq); ix <= cellOf(p.x() + mq); ++ix)
-      for (int iy = cellOf(p.y() - mq); iy <= cellOf(p.y() + mq); ++iy)
-        for (int iz = cellOf(p.z() - mq); iz <= cellOf(p.z() + mq); ++iz) {
+    const int x0 = cellOf(lx), x1 = cellOf(hx), y0 = cellOf(ly), y1 = cellOf(hy), z0 = cellOf(lz), z1 = cellOf(hz);
+    // Only a particle whose box spans several cells can meet a triangle twice.
+    const bool stamp = x1 > x0 || y1 > y0 || z1 > z0;
+#if defined(__SSE2__)
+    const __m128 queryLo = _mm_setr_ps(lx, ly, lz, -kInf), queryHi = _mm_setr_ps(hx, hy, hz, kInf);
+#endif
+    for (int ix = x0; ix <= x1; ++ix)
+      for (int iy = y0; iy <= y1; ++iy)
+        for (int iz = z0; iz <= z1; ++iz) {
+          // The bucket's overlapping entries first, without a branch per entry (about one in four
+          // overlaps: too many for branches to predict), then the exact tests.
           const std::uint32_t bucket = bucketOf(ix, iy, iz, mask);
-          for (std::uint32_t e = hashStart_[bucket]; e < hashStart_[bucket + 1]; ++e) {
-            const HashEntry& entry = hashEntries_[e];
-            consider(q, p, mq, entry.triangle, entry.lo, entry.hi);
+          const HashEntry* entry = hashEntries_.data() + hashStart_[bucket];
+          const std::uint32_t count = hashStart_[bucket + 1] - hashStart_[bucket];
+          std::uint32_t* found = bucketHits_.data();
+          std::uint32_t hits = 0;
+          for (std::uint32_t e = 0; e < count; ++e) {
+            found[hits] = e;
+#if defined(__SSE2__)
+            const __m128 inside = _mm_and_ps(_mm_cmpge_ps(queryHi, _mm_load_ps(entry[e].lo)),
+                                             _mm_cmple_ps(queryLo, _mm_load_ps(entry[e].hi)));
+            hits += _mm_movemask_ps(inside) == 0xF ? 1u : 0u;
+#else
+            hits += overlaps(entry[e].lo, entry[e].hi) ? 1u : 0u;
+#endif
+          }
+          for (std::uint32_t k = 0; k < hits; ++k) {
+            const std::uint32_t g = bitsIndex(entry[found[k]].lo[3]);
+            for (std::uint32_t t = clusterStart_[g]; t < clusterStart_[g + 1]; ++t) consider(q, p, t, stamp);
           }
         }
-    for (const std::uint32_t t : largeTriangles_) consider(q, p, mq, t, &triangleBoxes_[8 * t], &triangleBoxes_[8 * t + 3]);
+    for (const std::uint32_t t : largeTriangles_)
+      if (overlaps(&triangleBoxes_[8 * t], &triangleBoxes_[8 * t + 3])) consider(q, p, t, false);
   }
 }
 
@@ -201,6 +282,13 @@ void Cape::solveSelfContacts(const float* w) {
   for (SelfContact& k : selfContacts_) {
     const std::uint32_t ia = tri[3 * k.triangle], ib = tri[3 * k.triangle + 1], ic = tri[3 * k.triangle + 2];
     const Vec3 p = at(x, k.particle), a = at(x, ia), b = at(x, ib), c = at(x, ic);
+    if (k.side != 0.0f) {
+      // Most listed pairs are apart: on their side of the plane and at least the thickness from it, so
+      // farther than that from the triangle too. Rejected here without the nearest point.
+      const Vec3 n = (b - a).cross(c - a);
+      const float d = k.side * n.dot(p - a);
+      if (d >= 0.0f && d * d >= thickness * thickness * n.squaredNorm()) continue;
+    }
     const TriangleNearest bary = nearestOnTriangle(p, a, b, c);
     Vec3 normal;
     float distance;

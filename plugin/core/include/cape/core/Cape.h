@@ -73,6 +73,8 @@ class Cape {
   float selfCollisionThickness() const { return selfThickness(); }
   /// Self-contacts found for the last step (diagnostics and benchmarks).
   std::size_t selfContactCount() const { return selfContacts_.size(); }
+  /// Self-contact searches run so far (a search's contacts are kept over the steps its margin covers).
+  std::uint64_t selfContactSearches() const { return selfSearches_; }
 
   /// Sum over particles of kinetic and gravitational potential energy plus spring (Hooke) energy, J.
   double energy() const;
@@ -123,20 +125,31 @@ class Cape {
   };
   std::vector<SelfContact> selfContacts_;
   double selfContactsValidUntil_ = -1.0;     ///< s: the contacts cover the motion until this time.
+  std::uint64_t selfSearches_ = 0;           ///< Searches so far (diagnostics).
   std::vector<std::uint32_t> hashStart_;     ///< Spatial hash: bucket offsets (buckets + 1).
   /// A triangle in a bucket of the spatial hash, with its grown box inline: the search reads entries in order
   /// and rejects most by the box without touching the triangle.
-  struct HashEntry {
-    float lo[3];
-    float hi[3];
-    std::uint32_t triangle;
+  struct alignas(16) HashEntry {
+    float lo[4];  ///< [3]: the triangle's index, as float bits
+    float hi[4];  ///< [3]: +inf
   };
-  std::vector<HashEntry> hashEntries_;       ///< Spatial hash: triangles sorted by bucket.
+  std::vector<HashEntry> hashEntries_;       ///< Spatial hash: clusters of triangles sorted by bucket.
+  std::vector<std::uint32_t> bucketHits_;    ///< Search scratch: one bucket's entries that overlap (hashEntries_ size).
+  /// The particles a triangle never makes contacts with: its corners and, for each edge, the far corner of
+  /// the triangle across it (~0u on the border); padded to 8 for a two-compare test.
+  struct alignas(16) LocalSet {
+    std::uint32_t v[8];
+  };
+  std::vector<LocalSet> triangleLocal_;
   std::vector<float> triangleBoxes_;         ///< Per triangle: grown box (lo xyz, hi xyz), motion, radius, m.
   std::vector<std::uint32_t> triangleStamp_; ///< Last particle that met each triangle in the search.
   std::vector<std::uint32_t> largeTriangles_; ///< Triangles whose grown box is too big to bin.
-  std::vector<std::uint32_t> triangleBuckets_;     ///< The buckets each binned triangle went into...
-  std::vector<std::uint32_t> triangleBucketStart_; ///< ...from this offset per triangle (triangles + 1).
+  /// Triangles binned together: cluster g is [clusterStart_[g], clusterStart_[g + 1]), two consecutive
+  /// triangles that share an edge (a grid cell's halves, whose boxes are the cell's) or one.
+  std::vector<std::uint32_t> clusterStart_;
+  std::vector<float> clusterBoxes_;                ///< Per cluster: the union of its grown boxes, m.
+  std::vector<std::uint32_t> triangleBuckets_;     ///< The buckets each binned cluster went into...
+  std::vector<std::uint32_t> triangleBucketStart_; ///< ...from this offset per cluster (clusters + 1).
   Points stepMotion_;                        ///< Predicted displacement over the step, less the mean, m.
   Eigen::VectorXf selfWeight_;               ///< Inverse masses for the last self-contact pass, 1/kg.
   Eigen::VectorXf stepMotionNorm_;           ///< |stepMotion_| per particle, m.
