@@ -86,7 +86,7 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   hashStart_.assign(buckets + 1, 0u);
   hashEntries_.assign(8 * fabric_->triangleCount(), HashEntry{});
   bucketHits_.assign(hashEntries_.size(), 0u);
-  triangleBoxes_.assign(8 * fabric_->triangleCount(), 0.0f);
+  triangleBoxes_.assign(12 * fabric_->triangleCount(), 0.0f);
   {
     // The far corners across each triangle's edges: sort the edges (as vertex pairs) to meet each one's
     // two triangles. An edge of more than two triangles (a non-manifold mesh) gets no wings.

@@ -126,7 +126,7 @@ void Cape::findSelfContacts(float dt) {
       const float grow = thickness + slack + triMotion;
       const Vec3 tlo = a.cwiseMin(b).cwiseMin(c).array() - grow;
       const Vec3 thi = a.cwiseMax(b).cwiseMax(c).array() + grow;
-      float* box = &triangleBoxes_[8 * t];
+      float* box = &triangleBoxes_[12 * t];
       for (int k = 0; k < 3; ++k) {
         box[k] = tlo[k];
         box[3 + k] = thi[k];
@@ -135,6 +135,7 @@ void Cape::findSelfContacts(float dt) {
       const Vec3 centroid = (a + b + c) / 3.0f;
       box[6] = triMotion;
       box[7] = std::sqrt(std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()}));
+      for (int k = 0; k < 3; ++k) box[8 + k] = centroid[k];
       lo = lo.cwiseMin(tlo);
       hi = hi.cwiseMax(thi);
     }
@@ -202,7 +203,12 @@ void Cape::findSelfContacts(float dt) {
       if (triangleStamp_[t] == q) return;  // met already through another cell
       triangleStamp_[t] = q;
     }
-    const float* box = &triangleBoxes_[8 * t];
+    const float* box = &triangleBoxes_[12 * t];
+    // The bounding sphere first, with the two motions added (no corner read yet): it rejects most of what
+    // overlapping boxes let through, the cape's own neighbourhood (near, but moving along) among them.
+    const float d2 = (p - Vec3(box[8], box[9], box[10])).squaredNorm();
+    const float loose = thickness + slack + motion[q] + box[6] + box[7];
+    if (d2 > loose * loose) return;
     const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
     // How much closer the two may come: the particle's motion relative to the triangle's corners.
     const Vec3 mqv = stepMotion_.row(q).transpose();
@@ -210,10 +216,10 @@ void Cape::findSelfContacts(float dt) {
                                               (mqv - stepMotion_.row(ib).transpose()).squaredNorm(),
                                               (mqv - stepMotion_.row(ic).transpose()).squaredNorm()}));
     const float within = thickness + slack + closing;
-    // The bounding sphere first: it rejects the cape's own neighbourhood (near, but moving along) cheaply.
-    const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
+    // The sphere again with the relative motion, then the triangle itself.
     const float reach = within + box[7];
-    if ((p - (a + b + c) / 3.0f).squaredNorm() > reach * reach) return;
+    if (d2 > reach * reach) return;
+    const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
     const TriangleNearest w = nearestOnTriangle(p, a, b, c);
     const Vec3 nearest = w.wa * a + w.wb * b + w.wc * c;
     if ((p - nearest).squaredNorm() > within * within) return;
@@ -234,7 +240,7 @@ void Cape::findSelfContacts(float dt) {
     };
     if (spans(p.array() - mq, p.array() + mq)) {
       for (std::size_t t = 0; t < triangles; ++t)
-        if (overlaps(&triangleBoxes_[8 * t], &triangleBoxes_[8 * t + 3])) consider(q, p, static_cast<std::uint32_t>(t), false);
+        if (overlaps(&triangleBoxes_[12 * t], &triangleBoxes_[12 * t + 3])) consider(q, p, static_cast<std::uint32_t>(t), false);
       continue;
     }
     const int x0 = cellOf(lx), x1 = cellOf(hx), y0 = cellOf(ly), y1 = cellOf(hy), z0 = cellOf(lz), z1 = cellOf(hz);
@@ -269,7 +275,7 @@ void Cape::findSelfContacts(float dt) {
           }
         }
     for (const std::uint32_t t : largeTriangles_)
-      if (overlaps(&triangleBoxes_[8 * t], &triangleBoxes_[8 * t + 3])) consider(q, p, t, false);
+      if (overlaps(&triangleBoxes_[12 * t], &triangleBoxes_[12 * t + 3])) consider(q, p, t, false);
   }
 }
 

@@ -141,7 +141,7 @@ class Cape {
     std::uint32_t v[8];
   };
   std::vector<LocalSet> triangleLocal_;
-  std::vector<float> triangleBoxes_;         ///< Per triangle: grown box (lo xyz, hi xyz), motion, radius, m.
+  std::vector<float> triangleBoxes_;         ///< Per triangle: grown box (lo xyz, hi xyz), motion, radius, centroid xyz, pad; m.
   std::vector<std::uint32_t> triangleStamp_; ///< Last particle that met each triangle in the search.
   std::vector<std::uint32_t> largeTriangles_; ///< Triangles whose grown box is too big to bin.
   /// Triangles binned together: cluster g is [clusterStart_[g], clusterStart_[g + 1]), two consecutive
