@@ -240,7 +240,7 @@ void Cape::step(float dt, ColliderSpan colliders) {
   if (settings_.wind.model != WindSettings::Model::None)
     windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt), airVelocity_);
   // Self-contacts are found from where the cape is now and kept through the substeps. When the cape moves
-  // calmly (no particle faster than half a spacing per settings.timeStep relative to the cape as a whole),
+  // calmly (no particle faster than half a spacing per settings.timeStep relative to the cape's rigid motion),
   // one search covers a whole timeStep: a world stepping at 1/240 s then searches once per 1/60 s, with that
   // 1/60 s's motion bound. A faster cape searches again every few substeps, so that no particle moves more
   // than half a spacing between searches: a search over a whole fast frame would pair every particle with
@@ -248,16 +248,14 @@ void Cape::step(float dt, ColliderSpan colliders) {
   int searchEvery = 0;  // substeps between searches; 0: the contacts found earlier still cover this step
   if (settings_.selfCollision && settings_.integrator == Integrator::Xpbd &&
       state_.time + static_cast<double>(dt) > selfContactsValidUntil_ + 1e-9) {
-    const Eigen::RowVector3f mean = state_.velocities.colwise().mean();
-    float fastest2 = 0.0f;  // a plain loop: no temporary
-    for (Eigen::Index i = 0; i < state_.velocities.rows(); ++i)
-      fastest2 = std::max(fastest2, (state_.velocities.row(i) - mean).squaredNorm());
-    const float fastest = std::sqrt(fastest2);
+    // The fastest particle relative to the cape's rigid motion (predictSelfMotion), m/s.
+    const float fastest = predictSelfMotion(dt) / dt;
     const float calmMotion = 0.5f * meanSpacing_;
     constexpr float kSearchMotion = 1.0f;
-    if (fastest * settings_.timeStep < calmMotion) {
+    if (std::isfinite(fastest) && fastest * settings_.timeStep < calmMotion) {
       const float window = std::max(dt, settings_.timeStep);
-      findSelfContacts(window);
+      if (window != dt) predictSelfMotion(window);
+      findSelfContacts();
       ++selfSearches_;
       selfContactsValidUntil_ = state_.time + static_cast<double>(window);
     } else {
@@ -268,7 +266,8 @@ void Cape::step(float dt, ColliderSpan colliders) {
   }
   for (int k = 0; k < substeps; ++k) {
     if (searchEvery > 0 && k % searchEvery == 0) {
-      findSelfContacts(h * static_cast<float>(std::min(searchEvery, substeps - k)));
+      predictSelfMotion(h * static_cast<float>(std::min(searchEvery, substeps - k)));
+      findSelfContacts();
       ++selfSearches_;
     }
     const float s0 = static_cast<float>(k) / static_cast<float>(substeps);

@@ -90,7 +90,8 @@ class Cape {
   void solveSprings(float h);
   void solveTethers();
   void accumulateExternalAcceleration();
-  void findSelfContacts(float dt);
+  float predictSelfMotion(float dt);
+  void findSelfContacts();  ///< For the motion predictSelfMotion last predicted.
   void solveSelfContacts(const float* inverseMasses);
   float selfThickness() const;
 
@@ -150,7 +151,7 @@ class Cape {
   std::vector<float> clusterBoxes_;                ///< Per cluster: the union of its grown boxes, m.
   std::vector<std::uint32_t> triangleBuckets_;     ///< The buckets each binned cluster went into...
   std::vector<std::uint32_t> triangleBucketStart_; ///< ...from this offset per cluster (clusters + 1).
-  Points stepMotion_;                        ///< Predicted displacement over the step, less the mean, m.
+  Points stepMotion_;                        ///< Predicted displacement over the step, less a rigid motion, m.
   Eigen::VectorXf selfWeight_;               ///< Inverse masses for the last self-contact pass, 1/kg.
   Eigen::VectorXf stepMotionNorm_;           ///< |stepMotion_| per particle, m.
   float meanSpacing_ = 0.0f;                 ///< Mean structural rest length, m (sizes the hash cells).
