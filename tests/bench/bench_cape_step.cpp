@@ -22,13 +22,23 @@ void runFrames(benchmark::State& state, SceneKind kind, const CapeSettings& sett
   // Warm up one simulated second so that the cape is in contact with the body, as in the demos.
   for (int f = 0; f < 60; ++f) scene.advanceFrame();
   int frames = 0;
+  const std::uint64_t searchesBefore = scene.cape().selfContactSearches();
+  std::uint64_t searches = 0;  // the scene restarts every 540 frames: counted across restarts
   for (auto _ : state) {
     scene.advanceFrame();
     benchmark::DoNotOptimize(scene.cape().state().positions.data());
     // Loop the 10 s scene so long runs measure the same motion.
-    if (++frames % 540 == 0) scene = SimpleScene(kind, n, Attachment::Corners, settings);
+    if (++frames % 540 == 0) {
+      searches += scene.cape().selfContactSearches();
+      scene = SimpleScene(kind, n, Attachment::Corners, settings);
+    }
   }
   state.counters["particles"] = static_cast<double>(n) * n;
+  if (settings.selfCollision && frames > 0) {
+    // Self-contact searches per frame: one while the cape is calm, more while it outruns a spacing per frame.
+    searches += scene.cape().selfContactSearches();
+    state.counters["searches_per_frame"] = static_cast<double>(searches - searchesBefore) / frames;
+  }
   state.counters["particles_per_s"] =
       benchmark::Counter(static_cast<double>(n) * n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
