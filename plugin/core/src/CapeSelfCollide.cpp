@@ -1,8 +1,9 @@
 // Self-collision: predictive particle-triangle contacts (Lewin 2018, "Cloth Self Collision with Predictive
-// Contacts", GDC). At the start of a step every particle that could come within the thickness of a triangle
-// it does not belong to during the step is paired with it, and the side of the triangle it is on is noted.
-// The substeps then keep the particle on that side, at least the thickness away: as long as the cape starts
-// the step free of intersections, no particle can pass through a triangle, however fast the fold.
+// Contacts", GDC). At the start of a step (and every few substeps while the cape moves fast) every particle
+// that could come within the thickness of a triangle it does not belong to before the next search is paired
+// with it, and the side of the triangle it is on is noted. The substeps then keep the particle on that side,
+// at least the thickness away: as long as the cape starts free of intersections, no particle can pass
+// through a triangle, however fast the fold.
 #include "cape/core/Cape.h"
 
 #include "cape/core/Geometry.h"
@@ -49,8 +50,8 @@ inline bool overFace(float wa, float wb, float wc) { return wa >= -kFaceMargin &
 
 inline Vec3 at(const Points& x, std::uint32_t i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
 
-// A hash entry keeps its triangle's index in the unused fourth lane of the box's low corner, as the bits of
-// a float that every comparison below passes (at most 2^25 triangles: a positive finite float).
+// A hash entry keeps its cluster's index in the unused fourth lane of the box's low corner, as the bits of
+// a float that every comparison below passes (fewer than 2^25 clusters: a positive finite float).
 inline float indexBits(std::uint32_t i) {
   float f;
   std::memcpy(&f, &i, sizeof f);
