@@ -55,9 +55,9 @@ struct BulletScene::Character {
   }
 };
 
-std::unique_ptr<BulletScene> BulletScene::create(const RunOptions& options, std::string& error) {
+std::unique_ptr<BulletScene> BulletScene::create(const RunOptions& options, std::string& error, WorldKind kind) {
   std::unique_ptr<BulletScene> scene(new BulletScene());
-  if (!scene->build(options, error)) return nullptr;
+  if (!scene->build(options, kind, error)) return nullptr;
   return scene;
 }
 
@@ -66,7 +66,7 @@ BulletScene::~BulletScene() {
   if (world_ && ground_) world_->removeRigidBody(ground_.get());
 }
 
-bool BulletScene::build(const RunOptions& o, std::string& error) {
+bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error) {
   options_ = o;
   motion_ = MotionDesc::forScene(o.scene);
   rig_ = makeCapeRig(o.size, o.attachment, o.settings.bendStiffness > 0.0f);
@@ -78,13 +78,36 @@ bool BulletScene::build(const RunOptions& o, std::string& error) {
   configuration_ = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();
-  solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-  world_ = std::make_unique<btSoftRigidDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
-                                                       configuration_.get());
+  btSoftBodyWorldInfo* info = nullptr;
+  if (kind == WorldKind::Deformable) {
+    deformableSolver_ = std::make_unique<btDeformableBodySolver>();
+    auto solver = std::make_unique<btDeformableMultiBodyConstraintSolver>();
+    solver->setDeformableSolver(deformableSolver_.get());
+    auto world = std::make_unique<btDeformableMultiBodyDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver.get(),
+                                                                      configuration_.get(), deformableSolver_.get());
+    // Implicit (backward Euler, Newton with conjugate-gradient solves): explicit steps cannot hold stiff
+    // cloth at 1/240 s. Set on the world and on its solver (each keeps its own flag). Contacts and anchors
+    // by projection: with the default Lagrange multipliers the implicit solve leaves the nodes where they
+    // are (measured: a free cape does not even fall).
+    world->setImplicit(true);
+    world->setUseProjection(true);
+    deformableSolver_->setImplicit(true);
+    deformableWorld_ = world.get();
+    info = &world->getWorldInfo();
+    solver_ = std::move(solver);
+    world_ = std::move(world);
+  } else {
+    solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+    auto world = std::make_unique<btSoftRigidDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
+                                                            configuration_.get());
+    softRigidWorld_ = world.get();
+    info = &world->getWorldInfo();
+    world_ = std::move(world);
+  }
   world_->setGravity(btVector3(0, btScalar(-9.8), 0));
-  // Soft bodies (the btSoftBody twin of cape_compare) take gravity and air from the world's soft body info.
-  world_->getWorldInfo().m_gravity = world_->getGravity();
-  world_->getWorldInfo().air_density = btScalar(1.2);
+  // Soft bodies (the twins of cape_compare) take gravity and air from the world's soft body info.
+  info->m_gravity = world_->getGravity();
+  info->air_density = btScalar(1.2);
 
   groundShape_ = std::make_unique<btStaticPlaneShape>(btVector3(0, 1, 0), btScalar(0));
   ground_ = std::make_unique<btRigidBody>(btScalar(0), nullptr, groundShape_.get());

@@ -9,6 +9,9 @@
 
 #include "cape/character/Character.h"
 
+#include <BulletSoftBody/btDeformableBodySolver.h>
+#include <BulletSoftBody/btDeformableMultiBodyConstraintSolver.h>
+#include <BulletSoftBody/btDeformableMultiBodyDynamicsWorld.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 #include <btBulletDynamicsCommon.h>
@@ -26,16 +29,27 @@ struct PinSpec {
   btVector3 localPivot{0, 0, 0};
 };
 
+/// Which Bullet world the scene lives in: the soft-rigid world of btSoftBody (the default; our cape and
+/// the btSoftBody twin), or Bullet's deformable world (implicit deformable bodies, Featherstone multibodies),
+/// where cape_compare puts the deformable twin.
+enum class WorldKind { SoftRigid, Deformable };
+
 class BulletScene {
  public:
   /// Builds the world and its characters for the options; nullptr and a one-line reason on bad input
   /// (unreadable or malformed URDF, unknown attachment link, no link to attach to).
-  static std::unique_ptr<BulletScene> create(const RunOptions& options, std::string& error);
+  static std::unique_ptr<BulletScene> create(const RunOptions& options, std::string& error,
+                                             WorldKind kind = WorldKind::SoftRigid);
   ~BulletScene();
   BulletScene(const BulletScene&) = delete;
   BulletScene& operator=(const BulletScene&) = delete;
 
-  btSoftRigidDynamicsWorld& world() { return *world_; }
+  /// The world, whichever kind (actions, rigid bodies).
+  btDiscreteDynamicsWorld& world() { return *world_; }
+  /// The soft-rigid world, or nullptr in a deformable scene.
+  btSoftRigidDynamicsWorld* softRigidWorld() { return softRigidWorld_; }
+  /// The deformable world, or nullptr in a soft-rigid scene.
+  btDeformableMultiBodyDynamicsWorld* deformableWorld() { return deformableWorld_; }
   int characterCount() const { return static_cast<int>(characters_.size()); }
   /// The cape every character wears (fabric, pinned particles).
   const CapeRig& rig() const { return rig_; }
@@ -63,15 +77,18 @@ class BulletScene {
  private:
   struct Character;
   BulletScene() = default;
-  bool build(const RunOptions& options, std::string& error);
+  bool build(const RunOptions& options, WorldKind kind, std::string& error);
   void poseAt(double t);
 
   // Bullet's world, in construction order (destroyed in reverse).
   std::unique_ptr<btSoftBodyRigidBodyCollisionConfiguration> configuration_;
   std::unique_ptr<btCollisionDispatcher> dispatcher_;
   std::unique_ptr<btDbvtBroadphase> broadphase_;
-  std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
-  std::unique_ptr<btSoftRigidDynamicsWorld> world_;
+  std::unique_ptr<btDeformableBodySolver> deformableSolver_;  ///< Deformable worlds only.
+  std::unique_ptr<btConstraintSolver> solver_;
+  std::unique_ptr<btDiscreteDynamicsWorld> world_;
+  btSoftRigidDynamicsWorld* softRigidWorld_ = nullptr;            ///< world_, when it is one
+  btDeformableMultiBodyDynamicsWorld* deformableWorld_ = nullptr;  ///< world_, when it is one
   std::unique_ptr<btStaticPlaneShape> groundShape_;
   std::unique_ptr<btRigidBody> ground_;
 

@@ -1,6 +1,7 @@
 // cape_compare: the same scene (same character, colliders, attachments, stepping) with our cape and with the
-// btSoftBody twin, side by side. Prints one row per solver with every metric of shared/SCENARIOS.md, the
-// frame and cape times and each solver's cape time relative to ours; writes compare.csv, compare.json,
+// btSoftBody twin (and optionally the twin in Bullet's implicit deformable world), side by side. Prints one
+// row per solver with every metric of shared/SCENARIOS.md, the frame and cape times and each solver's cape
+// time relative to ours; writes compare.csv, compare.json,
 // per-frame CSVs and PNG plots. `cape_compare --help` lists the options.
 #include "BulletScene.h"
 #include "Plots.h"
@@ -45,39 +46,53 @@ void mergeWorst(FrameMetrics& into, const FrameMetrics& m, bool first) {
   into.blowUp = into.blowUp || m.blowUp;
 }
 
-/// The btSoftBody twins of every character of a scene, and the metrics measured on them exactly as on ours.
+/// The twins of every character of a scene, in a world of their own: btSoftBody twins in a soft-rigid world,
+/// or deformable twins in Bullet's deformable world. Measured exactly as ours.
 class TwinRun {
  public:
-  bool build(const RunOptions& o, const bullet::SoftBodyTwinSettings& twin, std::string& error) {
-    scene_ = BulletScene::create(o, error);
+  enum class Kind { SoftBody, Deformable };
+
+  bool build(const RunOptions& o, Kind kind, const bullet::SoftBodyTwinSettings& soft,
+             const bullet::DeformableTwinSettings& deformable, std::string& error) {
+    scene_ = BulletScene::create(o, error, kind == Kind::Deformable ? WorldKind::Deformable : WorldKind::SoftRigid);
     if (!scene_) return false;
     const CapeSettings settings = settingsForScene(o.scene, o.settings);
     for (int k = 0; k < scene_->characterCount(); ++k) {
       // A cape action (never added to the world) places the cape and holds the attachments the twin copies.
       auto proto = std::make_unique<bullet::CapeAction>(scene_->rig().fabric, settings, bullet::toBt(scene_->capePlacement(k)));
       for (const PinSpec& p : scene_->pins(k)) proto->attach(p.particle, p.body, p.localPivot);
-      std::unique_ptr<btSoftBody> body = bullet::makeSoftBodyTwin(scene_->world(), *proto, twin);
+      btSoftBody* body = nullptr;
+      if (kind == Kind::SoftBody) {
+        std::unique_ptr<btSoftBody> made = bullet::makeSoftBodyTwin(*scene_->softRigidWorld(), *proto, soft);
+        if (made && settings.wind.model != WindSettings::Model::None) {
+          // Bullet's own aerodynamics, two-sided, in the mean wind (btSoftBody has no gust field).
+          made->m_cfg.aeromodel = btSoftBody::eAeroModel::V_TwoSided;
+          made->m_cfg.kDG = btScalar(settings.wind.dragCoefficient);
+          made->m_cfg.kLF = btScalar(settings.wind.liftCoefficient);
+          made->setWindVelocity(bullet::toBt(settings.wind.direction.normalized() * settings.wind.speed));
+        }
+        body = made.get();
+        if (made) softBodies_.push_back(std::move(made));
+      } else {
+        std::unique_ptr<bullet::DeformableTwin> made = bullet::makeDeformableTwin(*scene_->deformableWorld(), *proto, deformable);
+        body = made ? &made->body() : nullptr;
+        if (made) deformables_.push_back(std::move(made));
+      }
       if (!body) {
-        error = "cannot build the btSoftBody twin";
+        error = "cannot build the Bullet twin";
         return false;
       }
-      if (settings.wind.model != WindSettings::Model::None) {
-        // Bullet's own aerodynamics, two-sided, in the mean wind (btSoftBody has no gust field).
-        body->m_cfg.aeromodel = btSoftBody::eAeroModel::V_TwoSided;
-        body->m_cfg.kDG = btScalar(settings.wind.dragCoefficient);
-        body->m_cfg.kLF = btScalar(settings.wind.liftCoefficient);
-        body->setWindVelocity(bullet::toBt(settings.wind.direction.normalized() * settings.wind.speed));
-      }
+      bodies_.push_back(body);
       positions_.push_back(Points::Zero(static_cast<Eigen::Index>(body->m_nodes.size()), 3));
       counters_.emplace_back();
       protos_.push_back(std::move(proto));
-      bodies_.push_back(std::move(body));
     }
     return true;
   }
   ~TwinRun() {
+    deformables_.clear();  // each removes itself from its world
     if (scene_)
-      for (auto& b : bodies_) scene_->world().removeSoftBody(b.get());
+      for (auto& b : softBodies_) scene_->softRigidWorld()->removeSoftBody(b.get());
   }
   double stepFrame(double t) { return scene_->stepFrame(t); }
   FrameMetrics measure(int k) {
@@ -110,11 +125,12 @@ class TwinRun {
  private:
   std::unique_ptr<BulletScene> scene_;
   std::vector<std::unique_ptr<bullet::CapeAction>> protos_;
-  std::vector<std::unique_ptr<btSoftBody>> bodies_;
+  std::vector<std::unique_ptr<btSoftBody>> softBodies_;
+  std::vector<std::unique_ptr<bullet::DeformableTwin>> deformables_;
+  std::vector<btSoftBody*> bodies_;
   std::vector<Points> positions_;
   std::vector<SelfIntersectionCounter> counters_;
 };
-
 
 json twinSettingsJson(const bullet::SoftBodyTwinSettings& t) {
   return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") + (t.bendLinks ? "bend" : "")},
@@ -124,15 +140,25 @@ json twinSettingsJson(const bullet::SoftBodyTwinSettings& t) {
           {"margin_m", t.margin}, {"collisions", "SDF_RS"}};
 }
 
+json deformableSettingsJson(const bullet::DeformableTwinSettings& t) {
+  return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") + (t.bendLinks ? "bend" : "")},
+          {"world", "btDeformableMultiBodyDynamicsWorld, implicit (backward Euler, Newton + CG)"},
+          {"elastic_stiffness_N_per_m", t.elasticStiffness}, {"damping_stiffness_Ns_per_m", t.dampingStiffness},
+          {"kDF", t.friction}, {"margin_m", t.margin}, {"collisions", "SDF_RD"}, {"wind", "none"}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"cape_compare: the same scene with our cape and with Bullet's btSoftBody twin, side by side; prints "
-               "every metric of SCENARIOS.md per solver and writes compare.csv, compare.json and PNG plots."};
+  CLI::App app{"cape_compare: the same scene with our cape and with Bullet's btSoftBody twin (and, with "
+               "--with-deformable, its deformable-world twin), side by side; prints every metric of SCENARIOS.md per "
+               "solver and writes compare.csv, compare.json and PNG plots."};
   SceneCli sceneCli;
   std::string out;
   int iterations = 10;
   bool noPlots = false;
+  bool withDeformable = false;
+  double deformableStiffness = 300.0;
   std::string render, renderSize = "960x360";
   addSceneOptions(app, sceneCli);
   app.add_option("--softbody-iterations", iterations, "btSoftBody position iterations (m_cfg.piterations)")
@@ -140,6 +166,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--out", out, "output folder (default: a fresh cape_compare_<scene>_<time> folder)");
   app.add_flag("--no-plots", noPlots, "do not draw the PNG plots");
+  app.add_flag("--with-deformable", withDeformable,
+               "also run the twin in Bullet's implicit deformable world (btDeformableMultiBodyDynamicsWorld)");
+  app.add_option("--deformable-stiffness", deformableStiffness,
+                 "the deformable twin's spring stiffness, N/m (it blows up at 1000 and above on the 20 x 20 cape)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--render", render,
                  "also render both capes side by side (ours left, btSoftBody right) as PNG frames, and run.mp4 and "
                  "run.gif with ffmpeg, into this folder");
@@ -169,18 +201,30 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
     return 1;
   }
-  TwinRun twinRun;
-  if (!twinRun.build(o, twin, error)) {
-    std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
-    return 1;
+  // The deformable twin: the same links (Bullet's mass-spring force has one stiffness for every link),
+  // friction and thickness; implicit steps. Its stiffness is not ours: on the 20 x 20 cape (1 g nodes) at
+  // 1/240 s the deformable world blows up at 1000 N/m and above (measured on the walk; 20000 N/m is ours),
+  // so the default is 300 N/m, the stiffest of the settings tried (100, 300, 1000, 20000) that stays finite.
+  bullet::DeformableTwinSettings deformable;
+  deformable.elasticStiffness = btScalar(deformableStiffness);
+  deformable.friction = btScalar(o.settings.friction);
+  deformable.margin = btScalar(o.settings.collisionThickness);
+
+  // Each twin in a world of its own, and beside it the same world with no cape at all: the rigid share of a
+  // frame, so that a twin's cape time is its frame time less that (its work happens inside stepSimulation,
+  // where it cannot be timed alone).
+  const int twinCount = withDeformable ? 2 : 1;
+  TwinRun twinRuns[2];
+  std::unique_ptr<BulletScene> bare[2];
+  for (int i = 0; i < twinCount; ++i) {
+    const TwinRun::Kind kind = i == 0 ? TwinRun::Kind::SoftBody : TwinRun::Kind::Deformable;
+    bare[i] = BulletScene::create(o, error, kind == TwinRun::Kind::Deformable ? WorldKind::Deformable : WorldKind::SoftRigid);
+    if (!bare[i] || !twinRuns[i].build(o, kind, twin, deformable, error)) {
+      std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
+      return 1;
+    }
   }
-  // The same world with no cape at all: the rigid share of a frame, so that the twin's cape time is its
-  // frame time less this (btSoftBody's work happens inside stepSimulation, where it cannot be timed alone).
-  std::unique_ptr<BulletScene> bare = BulletScene::create(o, error);
-  if (!bare) {
-    std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
-    return 1;
-  }
+  TwinRun& twinRun = twinRuns[0];
 
   const std::filesystem::path dir = out.empty() ? freshRunFolder(scene, "cape_compare") : std::filesystem::path(out);
   std::error_code ec;
@@ -209,29 +253,35 @@ int main(int argc, char** argv) {
 
   const double length = o.seconds > 0.0 ? o.seconds : MotionDesc::forScene(o.scene).duration;
   const int frames = static_cast<int>(std::lround(length * 60.0));
-  SolverResult results[2];
+  std::vector<SolverResult> results(static_cast<std::size_t>(1 + twinCount));
   results[0].name = "ours (XPBD cape)";
   results[0].settings = settingsJson(settingsForScene(o.scene, o.settings));
   results[1].name = "btSoftBody twin";
   results[1].settings = twinSettingsJson(twin);
+  if (withDeformable) {
+    results[2].name = "btDeformable twin";
+    results[2].settings = deformableSettingsJson(deformable);
+  }
   std::vector<SelfIntersectionCounter> counters(static_cast<std::size_t>(ours->characterCount()));
   Progress progress("cape_compare " + scene, frames);
   for (int f = 1; f <= frames; ++f) {
     const double t = f / 60.0;
     // Interleaved, so that the machine's noise falls on every solver alike.
     ours->advanceFrame();
-    const double twinFrame = twinRun.stepFrame(t);
-    const double bareFrame = bare->stepFrame(t);
-
     FrameRow a{f, t, ours->lastFrameTimeUs(), ours->lastCapeTimeUs(), {}};
     for (int k = 0; k < ours->characterCount(); ++k)
       mergeWorst(a.metrics, measureFrame(ours->cape(k), ours->bodyColliders(k), ours->torsoCentre(k), &counters[static_cast<std::size_t>(k)]), k == 0);
-    FrameRow b{f, t, twinFrame, std::max(0.0, twinFrame - bareFrame), {}};
-    for (int k = 0; k < twinRun.characterCount(); ++k) mergeWorst(b.metrics, twinRun.measure(k), k == 0);
     results[0].rows.push_back(a);
     results[0].recorder.add(a.metrics);
-    results[1].rows.push_back(b);
-    results[1].recorder.add(b.metrics);
+    for (int i = 0; i < twinCount; ++i) {
+      const double twinFrame = twinRuns[i].stepFrame(t);
+      const double bareFrame = bare[i]->stepFrame(t);
+      FrameRow b{f, t, twinFrame, std::max(0.0, twinFrame - bareFrame), {}};
+      for (int k = 0; k < twinRuns[i].characterCount(); ++k) mergeWorst(b.metrics, twinRuns[i].measure(k), k == 0);
+      SolverResult& r = results[static_cast<std::size_t>(1 + i)];
+      r.rows.push_back(b);
+      r.recorder.add(b.metrics);
+    }
     if (renderer) {
       renderer->record(0, ours->cape(0), ours->bodyColliders(0));
       twinMesh.update(twinRun.fabric(), twinRun.positions(0));
@@ -288,7 +338,8 @@ int main(int argc, char** argv) {
                 q.maxPenetration, q.framesPenetrationOver1mm, q.selfIntersectionsMax, q.pinErrorMax,
                 q.blowUp ? "YES" : "no");
     // Per-frame rows of each solver.
-    std::ofstream perFrame(dir / (std::string(&r == &results[0] ? "frames_ours" : "frames_btsoftbody") + ".csv"));
+    const char* perFrameName = &r == &results[0] ? "frames_ours" : &r == &results[1] ? "frames_btsoftbody" : "frames_deformable";
+    std::ofstream perFrame(dir / (std::string(perFrameName) + ".csv"));
     perFrame << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_intersections,pin_error_m,blow_up\n";
     for (const FrameRow& fr : r.rows) {
       std::snprintf(line, sizeof line, "%d,%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%d\n", fr.frame, fr.time, fr.frameTimeUs,
@@ -297,8 +348,9 @@ int main(int argc, char** argv) {
       perFrame << line;
     }
   }
-  std::printf("settings:\n  ours:       %s\n  btSoftBody: %s\n", results[0].settings.dump().c_str(),
+  std::printf("settings:\n  ours:         %s\n  btSoftBody:   %s\n", results[0].settings.dump().c_str(),
               results[1].settings.dump().c_str());
+  if (withDeformable) std::printf("  btDeformable: %s\n", results[2].settings.dump().c_str());
   std::ofstream(dir / "compare.json") << compare.dump(2) << "\n";
   if (renderer) {
     if (!renderer->finish(error)) {

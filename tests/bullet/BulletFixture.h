@@ -5,6 +5,9 @@
 #include "cape/bullet/CapeAction.h"
 #include "cape/core/Scene.h"
 
+#include <BulletSoftBody/btDeformableBodySolver.h>
+#include <BulletSoftBody/btDeformableMultiBodyConstraintSolver.h>
+#include <BulletSoftBody/btDeformableMultiBodyDynamicsWorld.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 #include <btBulletDynamicsCommon.h>
@@ -18,8 +21,28 @@ constexpr btScalar kFrame = btScalar(1.0 / 60.0);
 constexpr btScalar kFixed = btScalar(1.0 / 240.0);
 constexpr btScalar kSeedStep = btScalar(0.00875);
 
+/// Selects Bullet's deformable world (implicit steps) in World's constructor.
+struct DeformableWorldTag {};
+
 /// A Bullet world and the bodies the test made (removed and deleted in order at the end).
 struct World {
+  explicit World(DeformableWorldTag) {
+    config = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();
+    dispatcher = std::make_unique<btCollisionDispatcher>(config.get());
+    broadphase = std::make_unique<btDbvtBroadphase>();
+    deformableSolver = std::make_unique<btDeformableBodySolver>();
+    auto* s = new btDeformableMultiBodyConstraintSolver();
+    s->setDeformableSolver(deformableSolver.get());
+    solver.reset(s);
+    auto* w = new btDeformableMultiBodyDynamicsWorld(dispatcher.get(), broadphase.get(), s, config.get(),
+                                                     deformableSolver.get());
+    w->setImplicit(true);
+    w->setUseProjection(true);
+    deformableSolver->setImplicit(true);
+    w->getWorldInfo().m_gravity = btVector3(0, btScalar(-9.8), 0);
+    world.reset(w);
+    world->setGravity(btVector3(0, btScalar(-9.8), 0));
+  }
   explicit World(bool soft = false) {
     if (soft)
       config = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();
@@ -63,6 +86,7 @@ struct World {
     }
   }
   btSoftRigidDynamicsWorld* soft() { return static_cast<btSoftRigidDynamicsWorld*>(world.get()); }
+  btDeformableMultiBodyDynamicsWorld* deformable() { return static_cast<btDeformableMultiBodyDynamicsWorld*>(world.get()); }
 
   /// A static body (mass 0) with the shape at the transform; group/mask < 0: Bullet's defaults.
   btRigidBody* addStatic(btCollisionShape* shape, const btTransform& t, int group = -1, int mask = -1) {
@@ -92,6 +116,7 @@ struct World {
   std::unique_ptr<btCollisionConfiguration> config;
   std::unique_ptr<btCollisionDispatcher> dispatcher;
   std::unique_ptr<btBroadphaseInterface> broadphase;
+  std::unique_ptr<btDeformableBodySolver> deformableSolver;  ///< Deformable worlds only.
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver;
   std::unique_ptr<btDiscreteDynamicsWorld> world;
   std::vector<std::unique_ptr<btCollisionShape>> shapes;

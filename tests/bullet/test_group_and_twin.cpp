@@ -150,3 +150,39 @@ TEST(SoftBodyTwin, CollidesWithTheSameRigidBodies) {
   EXPECT_GT(middle.length(), 0.28f);
   w.soft()->removeSoftBody(twin.get());
 }
+
+// The deformable-world twin: the same nodes, links and anchors, driven by Bullet's implicit mass-spring and
+// gravity forces; carried along by a kinematic body walking at 1.2 m/s, it hangs below its pins, follows
+// them and stays finite.
+TEST(DeformableTwin, HangsFromTheBodyItIsAnchoredToAndFollowsIt) {
+  World w{DeformableWorldTag{}};
+  btRigidBody* body = w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)),
+                                     btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+  CapeAction action(cornerFabric(), cape::CapeSettings(),
+                    btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.56f, 0.15f)));
+  action.attach(0, body, btVector3(-0.3f, 0.06f, 0.15f));
+  action.attach(19, body, btVector3(0.3f, 0.06f, 0.15f));
+  const cape::Fabric& fabric = action.cape().fabric();
+  std::unique_ptr<cape::bullet::DeformableTwin> twin = cape::bullet::makeDeformableTwin(*w.deformable(), action);
+  ASSERT_NE(twin, nullptr);
+  const btSoftBody& b = twin->body();
+  EXPECT_EQ(b.m_nodes.size(), int(fabric.particleCount()));
+  EXPECT_EQ(b.m_links.size(), int(cape::kingsGraphSpringCount(20, 20)));
+  EXPECT_EQ(b.m_faces.size(), int(fabric.triangleCount()));
+  EXPECT_EQ(b.m_deformableAnchors.size(), 2);
+  EXPECT_NEAR(b.getTotalMass(), fabric.totalMass(), 1e-4);
+
+  for (int frame = 1; frame <= 60; ++frame) {
+    World::moveKinematic(body, btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, -0.02f * frame)));
+    w.world->stepSimulation(kFrame, 8, kFixed);
+  }
+  const btVector3 pin = body->getWorldTransform() * btVector3(-0.3f, 0.06f, 0.15f);
+  EXPECT_LT((b.m_nodes[0].m_x - pin).length(), 0.05f);
+  btVector3 mean(0, 0, 0);
+  for (int i = 0; i < b.m_nodes.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(b.m_nodes[i].m_x.y()));
+    mean += b.m_nodes[i].m_x / btScalar(b.m_nodes.size());
+  }
+  EXPECT_LT(mean.y(), pin.y() - 0.3f) << "hangs";
+  EXPECT_LT(std::abs(mean.z() - pin.z()), 0.3f) << "follows the body (it walked 1.2 m)";
+}

@@ -50,6 +50,29 @@ TEST(CapeCompare, WalkWritesOneRowPerSolverAndPlots) {
   for (const char* png : {"strain.png", "penetration.png", "frame_time.png"}) EXPECT_TRUE(isPng(dir / png)) << png;
 }
 
+// With --with-deformable a third row: the twin in Bullet's implicit deformable world, with its own settings
+// (the stiffness asked for) and per-frame CSV; it hangs on its pins without blowing up.
+TEST(CapeCompare, WithDeformableAddsBulletsDeformableWorld) {
+  const fs::path dir = freshDir();
+  const Result r = run(kCompare + " --scene walk --size 10 --seconds 0.5 --no-plots --with-deformable "
+                                  "--deformable-stiffness 250 --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("btDeformable twin"), std::string::npos) << r.output;
+  std::ifstream in(dir / "compare.json");
+  const json j = json::parse(in);
+  ASSERT_EQ(j["solvers"].size(), 3u);
+  const json& d = j["solvers"][2];
+  EXPECT_NE(d["name"].get<std::string>().find("Deformable"), std::string::npos);
+  EXPECT_DOUBLE_EQ(d["settings"]["elastic_stiffness_N_per_m"].get<double>(), 250.0);
+  EXPECT_FALSE(d["blow_up"].get<bool>());
+  EXPECT_LT(d["pin_error_max_m"].get<double>(), 0.1);
+  EXPECT_GT(d["cape_time_us_median"].get<double>(), 0.0);
+  EXPECT_EQ(lines(dir / "compare.csv").size(), 4u);
+  EXPECT_EQ(lines(dir / "frames_deformable.csv").size(), 31u);
+  // The stiffness must be positive.
+  EXPECT_NE(run(kCompare + " --with-deformable --deformable-stiffness 0 --seconds 0.1 --out " + freshDir().string()).exitCode, 0);
+}
+
 TEST(CapeCompare, SimpleBodyAndNoPlots) {
   const fs::path dir = freshDir();
   const Result r = run(kCompare + " --simple-body --scene sprint-turn --size 6 --seconds 0.25 --no-plots --out " + dir.string());

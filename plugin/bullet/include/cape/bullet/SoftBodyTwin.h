@@ -7,10 +7,13 @@
 
 #include "cape/bullet/CapeAction.h"
 
+#include <BulletSoftBody/btDeformableLagrangianForce.h>
+#include <BulletSoftBody/btDeformableMultiBodyDynamicsWorld.h>
 #include <BulletSoftBody/btSoftBody.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 
 #include <memory>
+#include <vector>
 
 namespace cape::bullet {
 
@@ -42,5 +45,50 @@ struct SoftBodyTwinSettings {
 /// fabric's (for drawing and aerodynamics).
 std::unique_ptr<btSoftBody> makeSoftBodyTwin(btSoftRigidDynamicsWorld& world, const CapeAction& cape,
                                              const SoftBodyTwinSettings& settings = SoftBodyTwinSettings());
+
+/// The twin for Bullet's deformable world (btDeformableMultiBodyDynamicsWorld: backward Euler with Newton
+/// and conjugate-gradient solves, Xuchen Han's solver of Bullet 3): the same nodes, masses, links, faces and
+/// anchors as makeSoftBodyTwin, driven by a mass-spring force and a gravity force. The world should step
+/// implicitly with projection (setImplicit(true), setUseProjection(true), and setImplicit(true) on its
+/// btDeformableBodySolver): with Lagrange multipliers the implicit solve leaves the nodes where they are.
+struct DeformableTwinSettings {
+  bool structuralLinks = true;  ///< Rows and columns.
+  bool shearLinks = true;       ///< Both diagonals of every cell.
+  bool bendLinks = false;       ///< Every second particle along rows and columns.
+  /// btDeformableMassSpringForce: Hooke stiffness of every link, N/m, and damping along the links, N s/m.
+  /// 300 N/m is about the stiffest the deformable world keeps finite on the 20 x 20 cape (1 g nodes) at
+  /// 1/240 s; it blows up from 1000 N/m (the cape's own structural springs are 20000 N/m).
+  btScalar elasticStiffness = btScalar(300);
+  btScalar dampingStiffness = btScalar(0.01);
+  btScalar friction = btScalar(0.3);  ///< m_cfg.kDF.
+  btScalar margin = btScalar(0.01);   ///< Collision margin, m.
+  /// m_cfg.collisions: the deformable world's signed-distance contacts against rigid bodies.
+  int collisions = btSoftBody::fCollision::SDF_RD;
+  int collisionGroup = btBroadphaseProxy::DefaultFilter;
+  int collisionMask = btBroadphaseProxy::AllFilter;
+};
+
+/// A deformable twin in its world; removes itself (body and forces) when destroyed, so it must not outlive
+/// the world.
+class DeformableTwin {
+ public:
+  DeformableTwin(btDeformableMultiBodyDynamicsWorld& world, std::unique_ptr<btSoftBody> body,
+                 std::vector<std::unique_ptr<btDeformableLagrangianForce>> forces);
+  ~DeformableTwin();
+  DeformableTwin(const DeformableTwin&) = delete;
+  DeformableTwin& operator=(const DeformableTwin&) = delete;
+  btSoftBody& body() { return *body_; }
+  const btSoftBody& body() const { return *body_; }
+
+ private:
+  btDeformableMultiBodyDynamicsWorld& world_;
+  std::unique_ptr<btSoftBody> body_;
+  std::vector<std::unique_ptr<btDeformableLagrangianForce>> forces_;
+};
+
+/// Builds the deformable twin of `cape` from its current state and attachments and adds it to `world`;
+/// nullptr if the cape is not ok. Anchors are Bullet's deformable anchors to the attachment bodies.
+std::unique_ptr<DeformableTwin> makeDeformableTwin(btDeformableMultiBodyDynamicsWorld& world, const CapeAction& cape,
+                                                   const DeformableTwinSettings& settings = DeformableTwinSettings());
 
 }  // namespace cape::bullet
