@@ -30,7 +30,7 @@ struct PinSpec {
 };
 
 /// Which Bullet world the scene lives in: the soft-rigid world of btSoftBody (the default; our cape and
-/// the btSoftBody twin), or Bullet's deformable world (implicit deformable bodies, Featherstone multibodies),
+/// the btSoftBody twin), or Bullet's deformable world (deformable bodies with Lagrangian forces, multibodies),
 /// where cape_compare puts the deformable twin.
 enum class WorldKind { SoftRigid, Deformable };
 

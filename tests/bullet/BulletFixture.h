@@ -21,7 +21,7 @@ constexpr btScalar kFrame = btScalar(1.0 / 60.0);
 constexpr btScalar kFixed = btScalar(1.0 / 240.0);
 constexpr btScalar kSeedStep = btScalar(0.00875);
 
-/// Selects Bullet's deformable world (implicit steps) in World's constructor.
+/// Selects Bullet's deformable world (explicit steps, as its cloth demos) in World's constructor.
 struct DeformableWorldTag {};
 
 /// A Bullet world and the bodies the test made (removed and deleted in order at the end).
@@ -36,9 +36,8 @@ struct World {
     solver.reset(s);
     auto* w = new btDeformableMultiBodyDynamicsWorld(dispatcher.get(), broadphase.get(), s, config.get(),
                                                      deformableSolver.get());
-    w->setImplicit(true);
-    w->setUseProjection(true);
-    deformableSolver->setImplicit(true);
+    w->getWorldInfo().m_sparsesdf.setDefaultVoxelsz(btScalar(0.25));
+    w->getWorldInfo().m_sparsesdf.Reset();
     w->getWorldInfo().m_gravity = btVector3(0, btScalar(-9.8), 0);
     world.reset(w);
     world->setGravity(btVector3(0, btScalar(-9.8), 0));

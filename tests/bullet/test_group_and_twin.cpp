@@ -151,7 +151,7 @@ TEST(SoftBodyTwin, CollidesWithTheSameRigidBodies) {
   w.soft()->removeSoftBody(twin.get());
 }
 
-// The deformable-world twin: the same nodes, links and anchors, driven by Bullet's implicit mass-spring and
+// The deformable-world twin: the same nodes, links and anchors, driven by Bullet's mass-spring and
 // gravity forces; carried along by a kinematic body walking at 1.2 m/s, it hangs below its pins, follows
 // them and stays finite.
 TEST(DeformableTwin, HangsFromTheBodyItIsAnchoredToAndFollowsIt) {

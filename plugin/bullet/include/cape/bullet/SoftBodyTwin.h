@@ -46,24 +46,24 @@ struct SoftBodyTwinSettings {
 std::unique_ptr<btSoftBody> makeSoftBodyTwin(btSoftRigidDynamicsWorld& world, const CapeAction& cape,
                                              const SoftBodyTwinSettings& settings = SoftBodyTwinSettings());
 
-/// The twin for Bullet's deformable world (btDeformableMultiBodyDynamicsWorld: backward Euler with Newton
-/// and conjugate-gradient solves, Xuchen Han's solver of Bullet 3): the same nodes, masses, links, faces and
-/// anchors as makeSoftBodyTwin, driven by a mass-spring force and a gravity force. The world should step
-/// implicitly with projection (setImplicit(true), setUseProjection(true), and setImplicit(true) on its
-/// btDeformableBodySolver): with Lagrange multipliers the implicit solve leaves the nodes where they are.
+/// The twin for Bullet's deformable world (btDeformableMultiBodyDynamicsWorld, Xuchen Han's solver of
+/// Bullet 3): the same nodes, masses, links, faces and anchors as makeSoftBodyTwin, driven by a mass-spring
+/// force and a gravity force. Step the world explicitly (its default), as Bullet's cloth demos do: on this
+/// cape the implicit mode leaves the nodes where they are with its Lagrange multipliers and blows up with
+/// projection (measured with Bullet 3.24).
 struct DeformableTwinSettings {
   bool structuralLinks = true;  ///< Rows and columns.
   bool shearLinks = true;       ///< Both diagonals of every cell.
   bool bendLinks = false;       ///< Every second particle along rows and columns.
   /// btDeformableMassSpringForce: Hooke stiffness of every link, N/m, and damping along the links, N s/m.
-  /// 300 N/m is about the stiffest the deformable world keeps finite on the 20 x 20 cape (1 g nodes) at
-  /// 1/240 s; it blows up from 1000 N/m (the cape's own structural springs are 20000 N/m).
-  btScalar elasticStiffness = btScalar(300);
-  btScalar dampingStiffness = btScalar(0.01);
+  /// 50 N/m is about the stiffest the deformable world keeps finite with the 20 x 20 cape's 1 g nodes at
+  /// 1/240 s (100 N/m blows up, measured); the cape's own structural springs are 20000 N/m.
+  btScalar elasticStiffness = btScalar(50);
+  btScalar dampingStiffness = btScalar(0.1);
   btScalar friction = btScalar(0.3);  ///< m_cfg.kDF.
   btScalar margin = btScalar(0.01);   ///< Collision margin, m.
-  /// m_cfg.collisions: the deformable world's signed-distance contacts against rigid bodies.
-  int collisions = btSoftBody::fCollision::SDF_RD;
+  /// m_cfg.collisions: the deformable world's contacts against rigid bodies, nodes and faces.
+  int collisions = btSoftBody::fCollision::SDF_RD | btSoftBody::fCollision::SDF_RDF;
   int collisionGroup = btBroadphaseProxy::DefaultFilter;
   int collisionMask = btBroadphaseProxy::AllFilter;
 };
