@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cape {
 namespace {
@@ -166,6 +167,21 @@ TEST(SelfCollision, HugeMotionStaysBoundedAndFinite) {
   for (Eigen::Index i = 0; i < v.rows(); i += 2) v.row(i) << 400.0f, -300.0f, 500.0f;
   for (int f = 0; f < 5; ++f) scene.advanceFrame();
   EXPECT_TRUE(scene.cape().state().positions.allFinite());
+}
+
+// A cape that has already blown up (a NaN velocity, a user's bug) is left alone: no contacts, no search
+// loop over a non-finite motion, no crash (the Debug + sanitizer build checks the conversions).
+TEST(SelfCollision, ANonFiniteCapeFindsNoContacts) {
+  CapeSettings s;
+  s.selfCollision = true;
+  SimpleScene scene(SceneKind::Walk, 8, Attachment::Corners, s);
+  scene.advanceFrame();
+  scene.cape().mutableState().velocities(5, 1) = std::nanf("");
+  scene.advanceFrame();
+  EXPECT_EQ(scene.cape().selfContactCount(), 0u);
+  scene.cape().mutableState().velocities(6, 0) = std::numeric_limits<float>::infinity();
+  scene.advanceFrame();
+  EXPECT_EQ(scene.cape().selfContactCount(), 0u);
 }
 
 TEST(SelfCollision, ThicknessIsAutomaticOrAsSetAndBadValuesAreRejected) {

@@ -259,8 +259,11 @@ void Cape::step(float dt, ColliderSpan colliders) {
       ++selfSearches_;
       selfContactsValidUntil_ = state_.time + static_cast<double>(window);
     } else {
-      const float searches = std::min(static_cast<float>(substeps), std::ceil(fastest * dt / (kSearchMotion * meanSpacing_)));
-      searchEvery = static_cast<int>(std::ceil(static_cast<float>(substeps) / std::max(searches, 1.0f)));
+      // Enough searches that none covers more than kSearchMotion spacings; every substep at most (and for a
+      // non-finite motion, whose search finds nothing: findSelfContacts leaves a blown-up cape alone).
+      const float wanted = fastest * dt / (kSearchMotion * meanSpacing_);
+      const int searches = std::isfinite(wanted) ? static_cast<int>(std::clamp(std::ceil(wanted), 1.0f, static_cast<float>(substeps))) : substeps;
+      searchEvery = (substeps + searches - 1) / searches;
       selfContactsValidUntil_ = state_.time + static_cast<double>(dt);
     }
   }
