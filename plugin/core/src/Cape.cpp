@@ -239,20 +239,19 @@ void Cape::step(float dt, ColliderSpan colliders) {
   // far slower than a frame.
   if (settings_.wind.model != WindSettings::Model::None)
     windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt), airVelocity_);
-  // Self-contacts are found from where the cape is now and kept through the substeps. When the cape moves
-  // calmly (no particle faster than half a spacing per settings.timeStep relative to the cape's rigid motion),
-  // one search covers a whole timeStep: a world stepping at 1/240 s then searches once per 1/60 s, with that
-  // 1/60 s's motion bound. A faster cape searches again every few substeps, so that no particle moves more
-  // than half a spacing between searches: a search over a whole fast frame would pair every particle with
-  // every triangle it might sweep past, and the substeps would carry thousands of contacts.
+  // Self-contacts are found from where the cape is now and kept through the substeps. One search covers at
+  // most a spacing of motion (relative to the cape's rigid motion) and at most one settings.timeStep. A
+  // calm cape (no particle faster than a spacing per timeStep) searches once per timeStep: a world stepping
+  // at 1/240 s then searches once per 1/60 s, with that 1/60 s's motion bound. A faster one searches again
+  // every few substeps: a search over a whole fast frame would pair every particle with every triangle it
+  // might sweep past, and the substeps would carry thousands of contacts.
   int searchEvery = 0;  // substeps between searches; 0: the contacts found earlier still cover this step
   if (settings_.selfCollision && settings_.integrator == Integrator::Xpbd &&
       state_.time + static_cast<double>(dt) > selfContactsValidUntil_ + 1e-9) {
     // The fastest particle relative to the cape's rigid motion (predictSelfMotion), m/s.
     const float fastest = predictSelfMotion(dt) / dt;
-    const float calmMotion = 0.5f * meanSpacing_;
-    constexpr float kSearchMotion = 1.0f;
-    if (std::isfinite(fastest) && fastest * settings_.timeStep < calmMotion) {
+    constexpr float kSearchMotion = 1.0f;  // spacings of motion one search may cover
+    if (std::isfinite(fastest) && fastest * settings_.timeStep < kSearchMotion * meanSpacing_) {
       const float window = std::max(dt, settings_.timeStep);
       if (window != dt) predictSelfMotion(window);
       findSelfContacts();
