@@ -2,6 +2,8 @@
 
 #include "cape/core/Wind.h"
 
+#include "SpringSolver.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -396,41 +398,6 @@ void Cape::stepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
   }
 }
 
-namespace {
-
-/// XPBD distance constraints C = |xj - xi| - L with compliance alpha (Macklin et al. 2016):
-///   dlambda = (-C - alpha~ lambda) / (wi + wj + alpha~),  alpha~ = alpha / h^2,
-///   xi -= wi dlambda n,  xj += wj dlambda n,  n = (xj - xi) / |xj - xi|.
-/// Springs [begin, end) share no particle (one colour), so consecutive iterations do not wait on each other's
-/// stores and the processor overlaps their square roots and divisions. (Measured: explicit 8-lane SIMD
-/// batches with gathers and scatters were 15 % slower than this scalar loop at N = 20.)
-void solveSpringColour(float* __restrict px, float* __restrict py, float* __restrict pz, const float* __restrict w,
-                       const std::uint32_t* __restrict first, const std::uint32_t* __restrict second,
-                       const float* __restrict rest, const float* __restrict invDenominator,
-                       float* __restrict lambda, std::size_t begin, std::size_t end, float alpha) {
-  for (std::size_t s = begin; s < end; ++s) {
-    const std::uint32_t i = first[s], j = second[s];
-    const float wi = w[i], wj = w[j];
-    const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
-    const float len2 = dx * dx + dy * dy + dz * dz;
-    // invDenominator is 0 when both ends are pinned; a zero length has no direction.
-    if (!(len2 > 1e-18f)) continue;
-    const float len = std::sqrt(len2);
-    const float dl = (rest[s] - len - alpha * lambda[s]) * invDenominator[s];
-    lambda[s] += dl;
-    const float k = dl / len;
-    const float cx = k * dx, cy = k * dy, cz = k * dz;
-    px[i] -= wi * cx;
-    py[i] -= wi * cy;
-    pz[i] -= wi * cz;
-    px[j] += wj * cx;
-    py[j] += wj * cy;
-    pz[j] += wj * cz;
-  }
-}
-
-}  // namespace
-
 void Cape::prepareSpringDenominators(float h) {
   // 1 / (w_i + w_j + alpha / h^2) of every spring: constant over the step's substeps, so the solver loop
   // multiplies instead of dividing. 0 when both ends are pinned (no correction).
@@ -450,52 +417,34 @@ void Cape::prepareSpringDenominators(float h) {
 }
 
 void Cape::solveSprings(float h) {
-  float* px = state_.positions.col(0).data();
-  float* py = state_.positions.col(1).data();
-  float* pz = state_.positions.col(2).data();
-  const float* w = state_.inverseMasses.data();
-  float* lambda = lambda_.data();
-  const float* invDenominator = invDenominator_.data();
+  // XPBD distance constraints, family after family, each family's springs in its fabric order (colour after
+  // colour); the kernel and its equations are in SpringSolver.h.
+  detail::SpringSolveArrays arrays;
+  arrays.px = state_.positions.col(0).data();
+  arrays.py = state_.positions.col(1).data();
+  arrays.pz = state_.positions.col(2).data();
+  arrays.inverseMass = state_.inverseMasses.data();
+  arrays.lambda = lambda_.data();
+  arrays.invDenominator = invDenominator_.data();
   const float invH2 = 1.0f / (h * h);
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
     const float compliance = familyCompliance_[static_cast<std::size_t>(f)];
     if (!std::isinf(compliance)) {
-      const float alpha = compliance * invH2;
-      for (std::size_t c = 0; c < set.colourCount(); ++c) {
-        solveSpringColour(px, py, pz, w, set.first.data(), set.second.data(), set.restLength.data(), invDenominator,
-                          lambda, set.colourStart[c], set.colourStart[c + 1], alpha);
-      }
+      arrays.first = set.first.data();
+      arrays.second = set.second.data();
+      arrays.restLength = set.restLength.data();
+      for (const SpringRun& run : set.runs) detail::solveSpringRun(arrays, run, compliance * invH2);
     }
-    lambda += set.size();
-    invDenominator += set.size();
+    arrays.lambda += set.size();
+    arrays.invDenominator += set.size();
   }
 }
 
 void Cape::solveTethers() {
-  // Unilateral: |x_p - x_a| <= maxLength while the anchor a is pinned (w_a = 0), so only p moves, straight
-  // towards the anchor. The fabric orders tethers so that consecutive ones belong to different particles, and
-  // the update is a select rather than a branch (whether a tether is taut is close to random from one to
-  // the next, and mispredicted branches cost more than the square root).
-  const TetherSet& t = fabric_->tethers();
-  float* __restrict px = state_.positions.col(0).data();
-  float* __restrict py = state_.positions.col(1).data();
-  float* __restrict pz = state_.positions.col(2).data();
-  const float* __restrict w = state_.inverseMasses.data();
-  const std::uint32_t* __restrict particle = t.particle.data();
-  const std::uint32_t* __restrict anchor = t.anchor.data();
-  const float* __restrict maxLength = t.maxLength.data();
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    const std::uint32_t a = anchor[k], p = particle[k];
-    const float dx = px[p] - px[a], dy = py[p] - py[a], dz = pz[p] - pz[a];
-    const float len2 = dx * dx + dy * dy + dz * dz;
-    const float maxLen = maxLength[k];
-    const bool taut = w[a] == 0.0f && w[p] != 0.0f && len2 > maxLen * maxLen;
-    const float scale = maxLen / std::sqrt(std::max(len2, 1e-30f));
-    px[p] = taut ? px[a] + dx * scale : px[p];
-    py[p] = taut ? py[a] + dy * scale : py[p];
-    pz[p] = taut ? pz[a] + dz * scale : pz[p];
-  }
+  // Long-range attachments (Fabric.h's TetherSet); the kernel is in SpringSolver.h.
+  detail::solveTethers(state_.positions.col(0).data(), state_.positions.col(1).data(), state_.positions.col(2).data(),
+                       state_.inverseMasses.data(), fabric_->tethers());
 }
 
 void Cape::stepExplicit(float h, float s0, float s1, ColliderSpan colliders) {

@@ -63,6 +63,48 @@ void colour(SpringSet& set, std::size_t particles) {
   set = std::move(sorted);
 }
 
+// The vector layout of springs [s, s + 4) of one colour: Gathered when their indices follow no pattern.
+SpringLayout blockLayout(const SpringSet& set, std::size_t s) {
+  const auto f = [&](std::size_t k) { return static_cast<std::int64_t>(set.first[s + k]); };
+  const auto g = [&](std::size_t k) { return static_cast<std::int64_t>(set.second[s + k]); };
+  const bool firstContiguous = f(1) == f(0) + 1 && f(2) == f(0) + 2 && f(3) == f(0) + 3;
+  if (firstContiguous && g(1) == g(0) + 1 && g(2) == g(0) + 2 && g(3) == g(0) + 3) return SpringLayout::Contiguous;
+  if (firstContiguous && g(1) == g(0) - 1 && g(2) == g(0) + 2 && g(3) == g(0) + 1) return SpringLayout::PairSwapped;
+  bool interleaved = true, pairs = true;
+  constexpr std::int64_t kPairOffset[4] = {0, 1, 4, 5};
+  for (std::size_t k = 0; k < 4; ++k) {
+    interleaved = interleaved && f(k) == f(0) + 2 * static_cast<std::int64_t>(k) && g(k) == f(k) + 1;
+    pairs = pairs && f(k) == f(0) + kPairOffset[k] && g(k) == f(k) + 2;
+  }
+  if (interleaved) return SpringLayout::Interleaved;
+  if (pairs) return SpringLayout::Pairs;
+  return SpringLayout::Gathered;
+}
+
+// Cuts each colour into blocks of four that follow a vector layout, the springs between them scalar. Blocks
+// never straddle two colours (the four springs of a block must share no particle); consecutive blocks of one
+// layout, and consecutive scalar springs, share a run, since a run is solved block after block in order.
+void planRuns(SpringSet& set) {
+  set.runs.clear();
+  const auto add = [&](std::size_t begin, std::size_t end, SpringLayout layout) {
+    if (!set.runs.empty() && set.runs.back().end == begin && set.runs.back().layout == layout) {
+      set.runs.back().end = static_cast<std::uint32_t>(end);
+    } else {
+      set.runs.push_back({static_cast<std::uint32_t>(begin), static_cast<std::uint32_t>(end), layout});
+    }
+  };
+  for (std::size_t c = 0; c < set.colourCount(); ++c) {
+    const std::size_t end = set.colourStart[c + 1];
+    std::size_t s = set.colourStart[c];
+    while (s < end) {
+      const SpringLayout layout = s + 4 > end ? SpringLayout::Scalar : blockLayout(set, s);
+      const std::size_t next = layout == SpringLayout::Scalar ? s + 1 : s + 4;
+      add(s, next, layout);
+      s = next;
+    }
+  }
+}
+
 }  // namespace
 
 FabricResult Fabric::grid(const GridDesc& d) {
@@ -219,7 +261,10 @@ FabricResult Fabric::fromMesh(const MeshDesc& d) {
 Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale) {
   const std::size_t n = particleCount();
   if (springCount() == 0) return Status::error("Fabric: no springs");
-  for (auto& set : springs_) colour(set, n);
+  for (auto& set : springs_) {
+    colour(set, n);
+    planRuns(set);
+  }
   for (auto& set : springs_) {
     set.restLength.resize(set.size());
     for (std::size_t s = 0; s < set.size(); ++s) {

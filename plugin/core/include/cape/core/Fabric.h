@@ -16,6 +16,27 @@ enum class SpringFamily : int { Structural = 0, Shear = 1, Bend = 2 };
 constexpr int kSpringFamilyCount = 3;
 const char* toString(SpringFamily family);
 
+/// How the solver reads the particles of a run of springs. Four consecutive springs whose indices follow one
+/// of the vector patterns below are solved together with vector loads and stores of whole neighbourhoods
+/// (the grid's rows, columns and diagonals fall into them); anything else one spring at a time. With p the
+/// first particle of the block and q its second:
+enum class SpringLayout : std::uint8_t {
+  Scalar,       ///< Any indices, one spring at a time.
+  Contiguous,   ///< first p, p+1, p+2, p+3; second q, q+1, q+2, q+3 (a grid's columns and diagonals).
+  PairSwapped,  ///< first p, p+1, p+2, p+3; second q, q-1, q+2, q+1 (a grid's two diagonals of a cell).
+  Interleaved,  ///< first p, p+2, p+4, p+6; second first + 1 (every other spring along a row).
+  Pairs,        ///< first p, p+1, p+4, p+5; second first + 2 (bend springs along a row).
+  Gathered,     ///< Any four springs of one colour: the particles read and written one by one, the
+                ///< arithmetic four at a time.
+};
+
+/// Springs [begin, end) of a set, read with one layout. A vector run holds a whole number of blocks of four.
+struct SpringRun {
+  std::uint32_t begin = 0;
+  std::uint32_t end = 0;
+  SpringLayout layout = SpringLayout::Scalar;
+};
+
 /// Springs of one family as parallel arrays (structure of arrays), solved in this order. The build sorts
 /// them by colour: springs [colourStart[k], colourStart[k+1]) share no particle, so consecutive springs in
 /// the solver loop do not wait on each other (and a colour could be solved in parallel).
@@ -24,6 +45,10 @@ struct SpringSet {
   std::vector<std::uint32_t> second;  ///< Particle index of the other end.
   std::vector<float> restLength;      ///< |x_first - x_second| at rest, m (> 0).
   std::vector<std::uint32_t> colourStart;  ///< Offsets of each colour, plus the end.
+  /// The set cut into runs, in order (built with the colouring); no block of four straddles two colours.
+  /// Solving the runs in order is solving the springs in order: the four springs of a block share no
+  /// particle, so solving them together gives the same bits as one after another.
+  std::vector<SpringRun> runs;
   std::size_t size() const { return first.size(); }
   std::size_t colourCount() const { return colourStart.empty() ? 0 : colourStart.size() - 1; }
 };

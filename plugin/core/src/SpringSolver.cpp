@@ -1,0 +1,247 @@
+#include "SpringSolver.h"
+
+#include <algorithm>
+#include <cmath>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace cape::detail {
+
+void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde) {
+  float* __restrict px = a.px;
+  float* __restrict py = a.py;
+  float* __restrict pz = a.pz;
+  const float* __restrict w = a.inverseMass;
+  float* __restrict lambda = a.lambda;
+  // Springs of one colour share no particle, so consecutive iterations do not wait on each other's stores
+  // and the processor overlaps their square roots and divisions.
+  for (std::uint32_t s = begin; s < end; ++s) {
+    const std::uint32_t i = a.first[s], j = a.second[s];
+    const float wi = w[i], wj = w[j];
+    const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
+    const float len2 = dx * dx + dy * dy + dz * dz;
+    // invDenominator is 0 when both ends are pinned; a zero length has no direction.
+    if (!(len2 > 1e-18f)) continue;
+    const float len = std::sqrt(len2);
+    const float dl = (a.restLength[s] - len - alphaTilde * lambda[s]) * a.invDenominator[s];
+    lambda[s] += dl;
+    const float k = dl / len;
+    const float cx = k * dx, cy = k * dy, cz = k * dz;
+    px[i] -= wi * cx;
+    py[i] -= wi * cy;
+    pz[i] -= wi * cz;
+    px[j] += wj * cx;
+    py[j] += wj * cy;
+    pz[j] += wj * cz;
+  }
+}
+
+void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers,
+                        std::size_t begin, std::size_t end) {
+  // The update is a select rather than a branch: whether a tether is taut is close to random from one to the
+  // next, and mispredicted branches cost more than the square root.
+  const float* __restrict w = inverseMass;
+  for (std::size_t k = begin; k < end; ++k) {
+    const std::uint32_t a = tethers.anchor[k], p = tethers.particle[k];
+    const float dx = px[p] - px[a], dy = py[p] - py[a], dz = pz[p] - pz[a];
+    const float len2 = dx * dx + dy * dy + dz * dz;
+    const float maxLen = tethers.maxLength[k];
+    const bool taut = w[a] == 0.0f && w[p] != 0.0f && len2 > maxLen * maxLen;
+    const float scale = maxLen / std::sqrt(std::max(len2, 1e-30f));
+    px[p] = taut ? px[a] + dx * scale : px[p];
+    py[p] = taut ? py[a] + dy * scale : py[p];
+    pz[p] = taut ? pz[a] + dz * scale : pz[p];
+  }
+}
+
+#if defined(__SSE2__)
+
+namespace {
+
+// Loads the values of a block's first ends (vi) and second ends (vj) from one array, and stores them back,
+// for each vector layout; i and j point at the block's first and second indices. `p` is the block's first
+// particle, `q` its second (SpringLayout's notation).
+template <SpringLayout L>
+struct Lanes;
+
+template <>
+struct Lanes<SpringLayout::Contiguous> {
+  static void load(const float* x, const std::uint32_t* i, const std::uint32_t* j, __m128& vi, __m128& vj) {
+    const std::uint32_t p = i[0], q = j[0];
+    vi = _mm_loadu_ps(x + p);
+    vj = _mm_loadu_ps(x + q);
+  }
+  static void store(float* x, const std::uint32_t* i, const std::uint32_t* j, __m128 vi, __m128 vj) {
+    const std::uint32_t p = i[0], q = j[0];
+    _mm_storeu_ps(x + p, vi);
+    _mm_storeu_ps(x + q, vj);
+  }
+};
+
+template <>
+struct Lanes<SpringLayout::PairSwapped> {
+  // q is the second end of the block's first spring; its four second ends occupy [q - 1, q + 3).
+  static void load(const float* x, const std::uint32_t* i, const std::uint32_t* j, __m128& vi, __m128& vj) {
+    const std::uint32_t p = i[0], q = j[0];
+    vi = _mm_loadu_ps(x + p);
+    const __m128 t = _mm_loadu_ps(x + q - 1);  // x[q-1], x[q], x[q+1], x[q+2]
+    vj = _mm_shuffle_ps(t, t, _MM_SHUFFLE(2, 3, 0, 1));  // x[q], x[q-1], x[q+2], x[q+1]
+  }
+  static void store(float* x, const std::uint32_t* i, const std::uint32_t* j, __m128 vi, __m128 vj) {
+    const std::uint32_t p = i[0], q = j[0];
+    _mm_storeu_ps(x + p, vi);
+    _mm_storeu_ps(x + q - 1, _mm_shuffle_ps(vj, vj, _MM_SHUFFLE(2, 3, 0, 1)));
+  }
+};
+
+template <>
+struct Lanes<SpringLayout::Interleaved> {
+  // [p, p + 8) holds first, second, first, second...
+  static void load(const float* x, const std::uint32_t* i, const std::uint32_t*, __m128& vi, __m128& vj) {
+    const std::uint32_t p = i[0];
+    const __m128 lo = _mm_loadu_ps(x + p), hi = _mm_loadu_ps(x + p + 4);
+    vi = _mm_shuffle_ps(lo, hi, _MM_SHUFFLE(2, 0, 2, 0));
+    vj = _mm_shuffle_ps(lo, hi, _MM_SHUFFLE(3, 1, 3, 1));
+  }
+  static void store(float* x, const std::uint32_t* i, const std::uint32_t*, __m128 vi, __m128 vj) {
+    const std::uint32_t p = i[0];
+    _mm_storeu_ps(x + p, _mm_unpacklo_ps(vi, vj));
+    _mm_storeu_ps(x + p + 4, _mm_unpackhi_ps(vi, vj));
+  }
+};
+
+template <>
+struct Lanes<SpringLayout::Pairs> {
+  // [p, p + 8) holds first, first, second, second, first, first, second, second.
+  static void load(const float* x, const std::uint32_t* i, const std::uint32_t*, __m128& vi, __m128& vj) {
+    const std::uint32_t p = i[0];
+    const __m128 lo = _mm_loadu_ps(x + p), hi = _mm_loadu_ps(x + p + 4);
+    vi = _mm_movelh_ps(lo, hi);
+    vj = _mm_movehl_ps(hi, lo);
+  }
+  static void store(float* x, const std::uint32_t* i, const std::uint32_t*, __m128 vi, __m128 vj) {
+    const std::uint32_t p = i[0];
+    _mm_storeu_ps(x + p, _mm_movelh_ps(vi, vj));
+    _mm_storeu_ps(x + p + 4, _mm_movehl_ps(vj, vi));
+  }
+};
+
+template <>
+struct Lanes<SpringLayout::Gathered> {
+  static void load(const float* x, const std::uint32_t* i, const std::uint32_t* j, __m128& vi, __m128& vj) {
+    vi = _mm_setr_ps(x[i[0]], x[i[1]], x[i[2]], x[i[3]]);
+    vj = _mm_setr_ps(x[j[0]], x[j[1]], x[j[2]], x[j[3]]);
+  }
+  static void store(float* x, const std::uint32_t* i, const std::uint32_t* j, __m128 vi, __m128 vj) {
+    alignas(16) float a[4], b[4];
+    _mm_store_ps(a, vi);
+    _mm_store_ps(b, vj);
+    for (int k = 0; k < 4; ++k) {
+      x[i[k]] = a[k];
+      x[j[k]] = b[k];
+    }
+  }
+};
+
+inline __m128 select(__m128 mask, __m128 ifTrue, __m128 ifFalse) {
+  return _mm_or_ps(_mm_and_ps(mask, ifTrue), _mm_andnot_ps(mask, ifFalse));
+}
+
+// solveSpringsScalar's body in four lanes. A lane whose spring has no direction keeps its old values (a
+// select, not a multiplication by zero, so not even the sign of a zero changes).
+template <SpringLayout L>
+void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde) {
+  using In = Lanes<L>;
+  const __m128 alpha = _mm_set1_ps(alphaTilde);
+  const __m128 minLen2 = _mm_set1_ps(1e-18f);
+  for (std::uint32_t s = begin; s < end; s += 4) {
+    const std::uint32_t* p = a.first + s;
+    const std::uint32_t* q = a.second + s;
+    __m128 xi, xj, yi, yj, zi, zj, wi, wj;
+    In::load(a.px, p, q, xi, xj);
+    In::load(a.py, p, q, yi, yj);
+    In::load(a.pz, p, q, zi, zj);
+    In::load(a.inverseMass, p, q, wi, wj);
+    const __m128 dx = _mm_sub_ps(xj, xi), dy = _mm_sub_ps(yj, yi), dz = _mm_sub_ps(zj, zi);
+    const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 active = _mm_cmpgt_ps(len2, minLen2);  // false for NaN too
+    const __m128 len = _mm_sqrt_ps(len2);
+    const __m128 lambda = _mm_loadu_ps(a.lambda + s);
+    const __m128 dl = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(a.restLength + s), len), _mm_mul_ps(alpha, lambda)),
+                                 _mm_loadu_ps(a.invDenominator + s));
+    _mm_storeu_ps(a.lambda + s, select(active, _mm_add_ps(lambda, dl), lambda));
+    const __m128 k = _mm_div_ps(dl, len);
+    const __m128 cx = _mm_mul_ps(k, dx), cy = _mm_mul_ps(k, dy), cz = _mm_mul_ps(k, dz);
+    In::store(a.px, p, q, select(active, _mm_sub_ps(xi, _mm_mul_ps(wi, cx)), xi),
+              select(active, _mm_add_ps(xj, _mm_mul_ps(wj, cx)), xj));
+    In::store(a.py, p, q, select(active, _mm_sub_ps(yi, _mm_mul_ps(wi, cy)), yi),
+              select(active, _mm_add_ps(yj, _mm_mul_ps(wj, cy)), yj));
+    In::store(a.pz, p, q, select(active, _mm_sub_ps(zi, _mm_mul_ps(wi, cz)), zi),
+              select(active, _mm_add_ps(zj, _mm_mul_ps(wj, cz)), zj));
+  }
+}
+
+}  // namespace
+
+void solveTethers(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers) {
+  const std::uint32_t* particle = tethers.particle.data();
+  const std::uint32_t* anchor = tethers.anchor.data();
+  const float* maxLength = tethers.maxLength.data();
+  const float* w = inverseMass;
+  const __m128 zero = _mm_setzero_ps(), tiny = _mm_set1_ps(1e-30f);
+  const auto gather = [](const float* x, const std::uint32_t* index) {
+    return _mm_setr_ps(x[index[0]], x[index[1]], x[index[2]], x[index[3]]);
+  };
+  std::size_t k = 0;
+  const std::size_t n = tethers.size();
+  while (k < n) {
+    const std::uint32_t p = particle[k];
+    if (k + 4 > n || particle[k + 1] != p + 1 || particle[k + 2] != p + 2 || particle[k + 3] != p + 3) {
+      solveTethersScalar(px, py, pz, inverseMass, tethers, k, k + 1);
+      ++k;
+      continue;
+    }
+    const __m128 xp = _mm_loadu_ps(px + p), yp = _mm_loadu_ps(py + p), zp = _mm_loadu_ps(pz + p);
+    const __m128 xa = gather(px, anchor + k), ya = gather(py, anchor + k), za = gather(pz, anchor + k);
+    const __m128 dx = _mm_sub_ps(xp, xa), dy = _mm_sub_ps(yp, ya), dz = _mm_sub_ps(zp, za);
+    const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 maxLen = _mm_loadu_ps(maxLength + k);
+    const __m128 taut = _mm_and_ps(_mm_and_ps(_mm_cmpeq_ps(gather(w, anchor + k), zero),
+                                              _mm_cmpneq_ps(_mm_loadu_ps(w + p), zero)),
+                                   _mm_cmpgt_ps(len2, _mm_mul_ps(maxLen, maxLen)));
+    // max(tiny, len2) is len2 when len2 is NaN, as std::max(len2, tiny) is.
+    const __m128 scale = _mm_div_ps(maxLen, _mm_sqrt_ps(_mm_max_ps(tiny, len2)));
+    _mm_storeu_ps(px + p, select(taut, _mm_add_ps(xa, _mm_mul_ps(dx, scale)), xp));
+    _mm_storeu_ps(py + p, select(taut, _mm_add_ps(ya, _mm_mul_ps(dy, scale)), yp));
+    _mm_storeu_ps(pz + p, select(taut, _mm_add_ps(za, _mm_mul_ps(dz, scale)), zp));
+    k += 4;
+  }
+}
+
+void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
+  switch (run.layout) {
+    case SpringLayout::Contiguous: return solveBlocks<SpringLayout::Contiguous>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::PairSwapped: return solveBlocks<SpringLayout::PairSwapped>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Interleaved: return solveBlocks<SpringLayout::Interleaved>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Pairs: return solveBlocks<SpringLayout::Pairs>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Gathered: return solveBlocks<SpringLayout::Gathered>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Scalar: break;
+  }
+  solveSpringsScalar(a, run.begin, run.end, alphaTilde);
+}
+
+#else
+
+void solveTethers(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers) {
+  solveTethersScalar(px, py, pz, inverseMass, tethers, 0, tethers.size());
+}
+
+void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
+  solveSpringsScalar(a, run.begin, run.end, alphaTilde);
+}
+
+#endif
+
+}  // namespace cape::detail

@@ -1,0 +1,49 @@
+// The constraint kernels of the solve: XPBD distance constraints over one family's springs, run by run, and
+// the long-range tethers (internal to the core; Cape::solveSprings and Cape::solveTethers call them,
+// tests/core/test_spring_solver.cpp checks the vector paths against the scalar loops bit for bit).
+#pragma once
+
+#include "cape/core/Fabric.h"
+
+#include <cstdint>
+
+namespace cape::detail {
+
+/// The arrays one family's solve reads and writes: positions as three columns, inverse masses, and per
+/// spring (indexed like the SpringSet) its rest length, 1 / (w_i + w_j + alpha~) and XPBD multiplier.
+struct SpringSolveArrays {
+  float* px = nullptr;
+  float* py = nullptr;
+  float* pz = nullptr;
+  const float* inverseMass = nullptr;
+  const std::uint32_t* first = nullptr;
+  const std::uint32_t* second = nullptr;
+  const float* restLength = nullptr;
+  const float* invDenominator = nullptr;
+  float* lambda = nullptr;
+};
+
+/// XPBD distance constraints C = |xj - xi| - L with compliance alpha (Macklin et al. 2016):
+///   dlambda = (-C - alpha~ lambda) / (wi + wj + alpha~),  alpha~ = alpha / h^2,
+///   xi -= wi dlambda n,  xj += wj dlambda n,  n = (xj - xi) / |xj - xi|,
+/// for springs [begin, end) one after another. A spring of zero (or non-finite) length has no direction and
+/// is left alone. `alphaTilde` is alpha / h^2.
+void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde);
+
+/// The same over a run, four springs at a time with vector loads and stores where the run's layout allows
+/// (SSE2 on x86-64; elsewhere one at a time). Bit for bit the result of solveSpringsScalar over the run:
+/// the four springs of a block share no particle and every lane does the scalar loop's operations in its
+/// order (the core is built without floating-point contraction).
+void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde);
+
+/// Unilateral tethers |x_p - x_a| <= maxLength while the anchor a is pinned (w_a = 0): a taut tether moves p
+/// straight towards a, onto the sphere of radius maxLength. One tether after another.
+void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers,
+                        std::size_t begin, std::size_t end);
+
+/// The same over all tethers, four at a time where four consecutive tethers move consecutive particles (the
+/// fabric lists every particle's nearest anchor, then every particle's second nearest...). Bit for bit the
+/// scalar loop: anchors are never tethered particles, so the four read nothing the others write.
+void solveTethers(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers);
+
+}  // namespace cape::detail

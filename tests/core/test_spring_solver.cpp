@@ -1,0 +1,233 @@
+// The constraint kernels alone (plugin/core/src/SpringSolver.h): the fabric's spring runs are a valid plan
+// (every spring once, in order; every block of four inside one colour, its indices following its layout),
+// and the vector paths give the scalar loops' bits, springs and tethers, with pinned, coincident and
+// non-finite particles among them.
+#include "SpringSolver.h"
+
+#include "CapeTestFixture.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <limits>
+#include <random>
+#include <set>
+#include <vector>
+
+namespace cape::test {
+namespace {
+
+FabricPtr meshFabric() {
+  // A 9 x 7 grid's triangles through the mesh builder (its own spring order, no shear family).
+  MeshDesc d;
+  const int nc = 9, nr = 7;
+  for (int r = 0; r < nr; ++r)
+    for (int c = 0; c < nc; ++c) d.positions.emplace_back(0.1f * static_cast<float>(c), -0.1f * static_cast<float>(r), 0.0f);
+  for (int r = 0; r + 1 < nr; ++r) {
+    for (int c = 0; c + 1 < nc; ++c) {
+      const auto id = [nc](int rr, int cc) { return static_cast<std::uint32_t>(rr * nc + cc); };
+      d.triangles.insert(d.triangles.end(), {id(r + 1, c), id(r + 1, c + 1), id(r, c + 1), id(r + 1, c), id(r, c + 1), id(r, c)});
+    }
+  }
+  d.tetherAnchors = {0, static_cast<std::uint32_t>(nc - 1)};
+  FabricResult result = Fabric::fromMesh(d);
+  EXPECT_TRUE(result.status.ok()) << result.status.message();
+  return result.fabric;
+}
+
+std::vector<FabricPtr> fabrics() {
+  return {makeGrid(20, 20, 0.6f, 1.0f, 0.4f, true, {0, 19}), makeGrid(7, 5, 0.6f, 1.0f, 0.4f, true, {0, 6}),
+          makeGrid(33, 17, 0.6f, 1.0f, 0.4f, false, {0, 32}), meshFabric()};
+}
+
+// The particles of block [s, s + 4) as the layout reads them, in lane order (first ends, then second ends).
+bool followsLayout(const SpringSet& set, std::size_t s, SpringLayout layout) {
+  const auto f = [&](std::size_t k) { return static_cast<long>(set.first[s + k]); };
+  const auto g = [&](std::size_t k) { return static_cast<long>(set.second[s + k]); };
+  const long p = f(0), q = g(0);
+  const long pairOffset[4] = {0, 1, 4, 5};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const long kk = static_cast<long>(k);
+    switch (layout) {
+      case SpringLayout::Contiguous:
+        if (f(k) != p + kk || g(k) != q + kk) return false;
+        break;
+      case SpringLayout::PairSwapped:
+        if (f(k) != p + kk || g(k) != q + (k % 2 == 0 ? kk : kk - 2)) return false;
+        break;
+      case SpringLayout::Interleaved:
+        if (f(k) != p + 2 * kk || g(k) != f(k) + 1) return false;
+        break;
+      case SpringLayout::Pairs:
+        if (f(k) != p + pairOffset[k] || g(k) != f(k) + 2) return false;
+        break;
+      case SpringLayout::Gathered: break;
+      case SpringLayout::Scalar: return false;
+    }
+  }
+  return true;
+}
+
+TEST(SpringRuns, CoverEverySpringOnceInOrderWithEveryBlockInsideOneColourAndItsLayout) {
+  for (const FabricPtr& fabric : fabrics()) {
+    ASSERT_TRUE(fabric);
+    for (int family = 0; family < kSpringFamilyCount; ++family) {
+      const SpringSet& set = fabric->springs(static_cast<SpringFamily>(family));
+      std::uint32_t next = 0;
+      for (const SpringRun& run : set.runs) {
+        ASSERT_EQ(run.begin, next) << "family " << family;
+        ASSERT_LT(run.begin, run.end);
+        next = run.end;
+        if (run.layout == SpringLayout::Scalar) continue;
+        ASSERT_EQ((run.end - run.begin) % 4, 0u);
+        for (std::uint32_t s = run.begin; s < run.end; s += 4) {
+          // Inside one colour, and so four distinct particles at each end and none shared.
+          const auto colour = std::upper_bound(set.colourStart.begin(), set.colourStart.end(), s) - set.colourStart.begin();
+          EXPECT_LE(s + 4, set.colourStart[static_cast<std::size_t>(colour)]) << "block at " << s << " straddles colours";
+          std::set<std::uint32_t> particles;
+          for (std::uint32_t k = 0; k < 4; ++k) particles.insert({set.first[s + k], set.second[s + k]});
+          EXPECT_EQ(particles.size(), 8u) << "block at " << s;
+          EXPECT_TRUE(followsLayout(set, s, run.layout)) << "family " << family << " block at " << s;
+        }
+      }
+      EXPECT_EQ(next, set.size()) << "family " << family;
+    }
+  }
+}
+
+TEST(SpringRuns, MostOfTheSeedGridsSpringsAreReadWithContiguousLoads) {
+  // The 20 x 20 cape: rows, columns and diagonals fall into the structured layouts, which load whole
+  // neighbourhoods; only what the greedy colouring scatters is gathered.
+  const FabricPtr fabric = makeGrid(20, 20);
+  std::size_t structured = 0, total = 0;
+  for (int family = 0; family < kSpringFamilyCount; ++family) {
+    const SpringSet& set = fabric->springs(static_cast<SpringFamily>(family));
+    total += set.size();
+    for (const SpringRun& run : set.runs)
+      if (run.layout != SpringLayout::Scalar && run.layout != SpringLayout::Gathered) structured += run.end - run.begin;
+  }
+  EXPECT_GE(static_cast<double>(structured), 0.75 * static_cast<double>(total)) << structured << " of " << total;
+}
+
+// A cape's worth of state: the rest positions jittered, a few particles pinned, two made to coincide with a
+// neighbour (a spring of zero length) and one not finite.
+struct KernelState {
+  std::vector<float> x, y, z, w, lambda, invDenominator;
+};
+
+KernelState jittered(const Fabric& fabric, unsigned seed) {
+  KernelState st;
+  const std::size_t n = fabric.particleCount();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> jitter(-0.02f, 0.02f);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Index r = static_cast<Eigen::Index>(i);
+    st.x.push_back(fabric.restPositions()(r, 0) * 1.05f + jitter(rng));
+    st.y.push_back(fabric.restPositions()(r, 1) * 1.05f + jitter(rng));
+    st.z.push_back(fabric.restPositions()(r, 2) + jitter(rng));
+    st.w.push_back(1.0f / fabric.masses()[r]);
+  }
+  st.w[0] = 0.0f;
+  st.w[n - 1] = 0.0f;
+  st.x[5] = st.x[4];
+  st.y[5] = st.y[4];
+  st.z[5] = st.z[4];
+  st.x[n / 2] = std::numeric_limits<float>::quiet_NaN();
+  st.lambda.assign(fabric.springCount(), 0.0f);
+  std::size_t k = 0;
+  for (int family = 0; family < kSpringFamilyCount; ++family) {
+    const SpringSet& set = fabric.springs(static_cast<SpringFamily>(family));
+    for (std::size_t s = 0; s < set.size(); ++s, ++k) {
+      const float wsum = st.w[set.first[s]] + st.w[set.second[s]];
+      st.invDenominator.push_back(wsum > 0.0f ? 1.0f / (wsum + 0.3f) : 0.0f);
+    }
+  }
+  return st;
+}
+
+void solveAll(const Fabric& fabric, KernelState& st, bool vector) {
+  std::size_t offset = 0;
+  for (int family = 0; family < kSpringFamilyCount; ++family) {
+    const SpringSet& set = fabric.springs(static_cast<SpringFamily>(family));
+    detail::SpringSolveArrays a;
+    a.px = st.x.data();
+    a.py = st.y.data();
+    a.pz = st.z.data();
+    a.inverseMass = st.w.data();
+    a.first = set.first.data();
+    a.second = set.second.data();
+    a.restLength = set.restLength.data();
+    a.invDenominator = st.invDenominator.data() + offset;
+    a.lambda = st.lambda.data() + offset;
+    const float alphaTilde = 0.01f * static_cast<float>(family);
+    if (vector) {
+      for (const SpringRun& run : set.runs) detail::solveSpringRun(a, run, alphaTilde);
+    } else {
+      detail::solveSpringsScalar(a, 0, static_cast<std::uint32_t>(set.size()), alphaTilde);
+    }
+    offset += set.size();
+  }
+}
+
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+TEST(SpringSolver, VectorRunsGiveTheScalarLoopsBits) {
+  for (const FabricPtr& fabric : fabrics()) {
+    ASSERT_TRUE(fabric);
+    KernelState vector = jittered(*fabric, 7), scalar = vector;
+    for (int iteration = 0; iteration < 5; ++iteration) {
+      solveAll(*fabric, vector, true);
+      solveAll(*fabric, scalar, false);
+    }
+    EXPECT_TRUE(sameBits(vector.x, scalar.x));
+    EXPECT_TRUE(sameBits(vector.y, scalar.y));
+    EXPECT_TRUE(sameBits(vector.z, scalar.z));
+    EXPECT_TRUE(sameBits(vector.lambda, scalar.lambda));
+    // And the springs did work: the jittered cape moved.
+    const KernelState start = jittered(*fabric, 7);
+    EXPECT_FALSE(sameBits(vector.y, start.y));
+  }
+}
+
+TEST(Tethers, VectorPathGivesTheScalarLoopsBits) {
+  for (const FabricPtr& fabric : fabrics()) {
+    ASSERT_TRUE(fabric);
+    const TetherSet& tethers = fabric->tethers();
+    ASSERT_GT(tethers.size(), 0u);
+    KernelState vector = jittered(*fabric, 11);
+    // Pin the anchors (one of them left free on the second fabric: its tethers must not act), and stretch
+    // the cape downwards so that the lower half is taut.
+    for (std::uint32_t a : tethers.anchor) vector.w[a] = 0.0f;
+    if (fabric->gridColumns() == 7) vector.w[tethers.anchor.back()] = 1.0f;
+    for (float& y : vector.y) y *= 1.3f;
+    const KernelState before = vector;
+    KernelState scalar = vector;
+    detail::solveTethers(vector.x.data(), vector.y.data(), vector.z.data(), vector.w.data(), tethers);
+    detail::solveTethersScalar(scalar.x.data(), scalar.y.data(), scalar.z.data(), scalar.w.data(), tethers, 0,
+                               tethers.size());
+    EXPECT_TRUE(sameBits(vector.x, scalar.x));
+    EXPECT_TRUE(sameBits(vector.y, scalar.y));
+    EXPECT_TRUE(sameBits(vector.z, scalar.z));
+    // The last tether of every particle holds it within its length of a pinned anchor (an earlier one may be
+    // loosened again by a later one); the taut ones moved their particles.
+    std::vector<std::size_t> last(fabric->particleCount(), tethers.size());
+    for (std::size_t k = 0; k < tethers.size(); ++k) last[tethers.particle[k]] = k;
+    std::size_t moved = 0;
+    for (std::size_t p = 0; p < last.size(); ++p) {
+      if (last[p] == tethers.size() || !std::isfinite(vector.x[p])) continue;
+      moved += vector.y[p] != before.y[p];
+      const std::uint32_t a = tethers.anchor[last[p]];
+      if (vector.w[a] != 0.0f || vector.w[p] == 0.0f) continue;
+      const float d = std::sqrt((vector.x[p] - vector.x[a]) * (vector.x[p] - vector.x[a]) +
+                                (vector.y[p] - vector.y[a]) * (vector.y[p] - vector.y[a]) +
+                                (vector.z[p] - vector.z[a]) * (vector.z[p] - vector.z[a]));
+      EXPECT_LE(d, tethers.maxLength[last[p]] * 1.00001f) << "particle " << p;
+    }
+    EXPECT_GT(moved, 0u);
+  }
+}
+
+}  // namespace
+}  // namespace cape::test
