@@ -86,6 +86,7 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   std::uint32_t buckets = 1;
   while (buckets < 2 * static_cast<std::uint32_t>(n)) buckets <<= 1;
   hashStart_.assign(buckets + 1, 0u);
+  bucketCluster_.assign(buckets, ~0u);
   hashEntries_.assign(8 * fabric_->triangleCount(), HashEntry{});
   bucketHits_.assign(hashEntries_.size(), 0u);
   triangleBoxes_.assign(12 * fabric_->triangleCount(), 0.0f);

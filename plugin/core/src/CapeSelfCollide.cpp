@@ -167,6 +167,7 @@ void Cape::findSelfContacts() {
   largeTriangles_.clear();
   triangleBuckets_.clear();
   std::fill(hashStart_.begin(), hashStart_.end(), 0u);
+  std::fill(bucketCluster_.begin(), bucketCluster_.end(), ~0u);
   // Binned by cluster (the two triangles of a grid cell share its box): half the entries of binning each.
   const std::size_t clusters = clusterStart_.size() - 1;
   for (std::size_t g = 0; g < clusters; ++g) {
@@ -208,8 +209,8 @@ void Cape::findSelfContacts() {
           const std::uint32_t bucket = bucketOf(ix, iy, iz, mask);
           // Once per bucket, even if two of its cells hash to the same one: a particle that visits a single
           // cell then meets each triangle at most once, and needs no stamps.
-          const auto first = triangleBuckets_.begin() + triangleBucketStart_[g];
-          if (std::find(first, triangleBuckets_.end(), bucket) != triangleBuckets_.end()) continue;
+          if (bucketCluster_[bucket] == g) continue;
+          bucketCluster_[bucket] = static_cast<std::uint32_t>(g);
           ++hashStart_[bucket + 1];
           triangleBuckets_.push_back(bucket);  // grows rarely: capacity kept between steps
         }

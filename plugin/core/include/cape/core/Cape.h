@@ -151,6 +151,7 @@ class Cape {
   std::vector<float> clusterBoxes_;                ///< Per cluster: the union of its grown boxes, m.
   std::vector<std::uint32_t> triangleBuckets_;     ///< The buckets each binned cluster went into...
   std::vector<std::uint32_t> triangleBucketStart_; ///< ...from this offset per cluster (clusters + 1).
+  std::vector<std::uint32_t> bucketCluster_;       ///< The last cluster binned into each bucket, per search.
   Points stepMotion_;                        ///< Predicted displacement over the step, less a rigid motion, m.
   Eigen::VectorXf selfWeight_;               ///< Inverse masses for the last self-contact pass, 1/kg.
   Eigen::VectorXf stepMotionNorm_;           ///< |stepMotion_| per particle, m.
