@@ -89,7 +89,7 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   bucketCluster_.assign(buckets, ~0u);
   hashEntries_.assign(8 * fabric_->triangleCount(), HashEntry{});
   bucketHits_.assign(hashEntries_.size(), 0u);
-  triangleBoxes_.assign(12 * fabric_->triangleCount(), 0.0f);
+  triangleMotion_.assign(fabric_->triangleCount(), 0.0f);
   {
     // The far corners across each triangle's edges: sort the edges (as vertex pairs) to meet each one's
     // two triangles. An edge of more than two triangles (a non-manifold mesh) gets no wings.
@@ -142,6 +142,21 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
     t = next;
   }
   clusterBoxes_.assign(6 * (clusterStart_.size() - 1), 0.0f);
+  // The particles local to every triangle of a cluster (at most four kept): the first triangle's local set,
+  // less what the others lack.
+  ClusterLocal noLocal;
+  std::fill(std::begin(noLocal.v), std::end(noLocal.v), ~0u);
+  clusterLocal_.assign(clusterStart_.size() - 1, noLocal);
+  for (std::size_t g = 0; g + 1 < clusterStart_.size(); ++g) {
+    std::size_t kept = 0;
+    for (const std::uint32_t q : triangleLocal_[clusterStart_[g]].v) {
+      if (q == ~0u || kept == 4) continue;
+      bool inAll = true;
+      for (std::uint32_t t = clusterStart_[g] + 1; t < clusterStart_[g + 1]; ++t)
+        inAll = inAll && std::find(std::begin(triangleLocal_[t].v), std::end(triangleLocal_[t].v), q) != std::end(triangleLocal_[t].v);
+      if (inAll) clusterLocal_[g].v[kept++] = q;
+    }
+  }
   triangleBucketStart_.assign(clusterStart_.size(), 0u);
   stepMotion_ = Points::Zero(n, 3);
   stepMotionNorm_ = Eigen::VectorXf::Zero(n);

@@ -131,7 +131,7 @@ class Cape {
   /// A triangle in a bucket of the spatial hash, with its grown box inline: the search reads entries in order
   /// and rejects most by the box without touching the triangle.
   struct alignas(16) HashEntry {
-    float lo[4];  ///< [3]: the triangle's index, as float bits
+    float lo[4];  ///< [3]: the cluster's index, as float bits
     float hi[4];  ///< [3]: +inf
   };
   std::vector<HashEntry> hashEntries_;       ///< Spatial hash: clusters of triangles sorted by bucket.
@@ -142,13 +142,19 @@ class Cape {
     std::uint32_t v[8];
   };
   std::vector<LocalSet> triangleLocal_;
-  std::vector<float> triangleBoxes_;         ///< Per triangle: grown box (lo xyz, hi xyz), motion, radius, centroid xyz, pad; m.
+  std::vector<float> triangleMotion_;        ///< Per triangle: the largest motion of its corners in the search, m.
   std::vector<std::uint32_t> triangleStamp_; ///< Last particle that met each triangle in the search.
   std::vector<std::uint32_t> largeTriangles_; ///< Triangles whose grown box is too big to bin.
   /// Triangles binned together: cluster g is [clusterStart_[g], clusterStart_[g + 1]), two consecutive
   /// triangles that share an edge (a grid cell's halves, whose boxes are the cell's) or one.
   std::vector<std::uint32_t> clusterStart_;
   std::vector<float> clusterBoxes_;                ///< Per cluster: the union of its grown boxes, m.
+  /// Per cluster: particles local to every one of its triangles (a grid cell's four corners; ~0u padding),
+  /// which meet nothing in it. Four, aligned for one compare.
+  struct alignas(16) ClusterLocal {
+    std::uint32_t v[4];
+  };
+  std::vector<ClusterLocal> clusterLocal_;
   std::vector<std::uint32_t> triangleBuckets_;     ///< The buckets each binned cluster went into...
   std::vector<std::uint32_t> triangleBucketStart_; ///< ...from this offset per cluster (clusters + 1).
   std::vector<std::uint32_t> bucketCluster_;       ///< The last cluster binned into each bucket, per search.
