@@ -71,7 +71,16 @@ class Cape {
 
   /// The self-collision thickness in use, m (the setting, or its automatic value).
   float selfCollisionThickness() const { return selfThickness(); }
-  /// Self-contacts found for the last step (diagnostics and benchmarks).
+  /// A predictive self-contact (Lewin 2018): a particle near a triangle it does not belong to, found at the
+  /// start of the step, with the side of the triangle it was on then (+1, -1, or 0 while its nearest point
+  /// is on the triangle's boundary). The solver keeps it on that side, at least the thickness away.
+  struct SelfContact {
+    std::uint32_t particle;
+    std::uint32_t triangle;
+    float side;
+  };
+  /// Self-contacts found by the last search (diagnostics, benchmarks and tests).
+  const std::vector<SelfContact>& selfContacts() const { return selfContacts_; }
   std::size_t selfContactCount() const { return selfContacts_.size(); }
   /// Self-contact searches run so far (a search's contacts are kept over the steps its margin covers).
   std::uint64_t selfContactSearches() const { return selfSearches_; }
@@ -116,14 +125,6 @@ class Cape {
   Eigen::ArrayXf distance2_;        ///< Broad-phase scratch, one per particle.
   std::vector<std::uint32_t> candidates_;  ///< Broad-phase scratch.
 
-  /// A predictive self-contact (Lewin 2018): a particle near a triangle it does not belong to, found at the
-  /// start of the step, with the side of the triangle it was on then (+1, -1, or 0 while its nearest point
-  /// is on the triangle's boundary). The solver keeps it on that side, at least the thickness away.
-  struct SelfContact {
-    std::uint32_t particle;
-    std::uint32_t triangle;
-    float side;
-  };
   std::vector<SelfContact> selfContacts_;
   double selfContactsValidUntil_ = -1.0;     ///< s: the contacts cover the motion until this time.
   std::uint64_t selfSearches_ = 0;           ///< Searches so far (diagnostics).
