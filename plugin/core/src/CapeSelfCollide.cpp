@@ -177,6 +177,14 @@ void Cape::findSelfContacts() {
 #endif
     return c[4] - c[0] <= kMaxSpan && c[5] - c[1] <= kMaxSpan && c[6] - c[2] <= kMaxSpan;
   };
+  // A triangle's box grown by the thickness, the slack and its motion (as binned, and for the rare unbinned
+  // paths).
+  auto grownBox = [&](std::uint32_t t, Vec3& lo, Vec3& hi) {
+    const Vec3 a = at(x, tri[3 * t]), b = at(x, tri[3 * t + 1]), c = at(x, tri[3 * t + 2]);
+    const float grow = thickness + slack + triangleMotion_[t];
+    lo = a.cwiseMin(b).cwiseMin(c).array() - grow;
+    hi = a.cwiseMax(b).cwiseMax(c).array() + grow;
+  };
   largeTriangles_.clear();
   triangleBuckets_.clear();
   std::fill(hashStart_.begin(), hashStart_.end(), 0u);
@@ -187,13 +195,9 @@ void Cape::findSelfContacts() {
     triangleBucketStart_[g] = static_cast<std::uint32_t>(triangleBuckets_.size());
     Vec3 lo = Vec3::Constant(std::numeric_limits<float>::max()), hi = -lo;
     for (std::uint32_t t = clusterStart_[g]; t < clusterStart_[g + 1]; ++t) {
-      const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
-      const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
-      const float triMotion = std::max({motion[ia], motion[ib], motion[ic]});
-      const float grow = thickness + slack + triMotion;
-      const Vec3 tlo = a.cwiseMin(b).cwiseMin(c).array() - grow;
-      const Vec3 thi = a.cwiseMax(b).cwiseMax(c).array() + grow;
-      triangleMotion_[t] = triMotion;
+      triangleMotion_[t] = std::max({motion[tri[3 * t]], motion[tri[3 * t + 1]], motion[tri[3 * t + 2]]});
+      Vec3 tlo, thi;
+      grownBox(t, tlo, thi);
       lo = lo.cwiseMin(tlo);
       hi = hi.cwiseMax(thi);
     }
@@ -256,17 +260,6 @@ void Cape::findSelfContacts() {
     return (q == v[0]) | (q == v[1]) | (q == v[2]) | (q == v[3]) | (q == v[4]) | (q == v[5]);
 #endif
   };
-  // A triangle's box grown by the thickness, the slack and its motion, as binned (for the rare unbinned paths).
-  auto grownBox = [&](std::uint32_t t, float* lo, float* hi) {
-    const Vec3 a = at(x, tri[3 * t]), b = at(x, tri[3 * t + 1]), c = at(x, tri[3 * t + 2]);
-    const float grow = thickness + slack + triangleMotion_[t];
-    const Vec3 tlo = a.cwiseMin(b).cwiseMin(c).array() - grow;
-    const Vec3 thi = a.cwiseMax(b).cwiseMax(c).array() + grow;
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = tlo[k];
-      hi[k] = thi[k];
-    }
-  };
   auto consider = [&](std::uint32_t q, const Vec3& p, std::uint32_t t, bool stamp) CAPE_ALWAYS_INLINE {
     if (local(q, t)) return;
     if (stamp) {
@@ -313,9 +306,9 @@ void Cape::findSelfContacts() {
     int range[8];
     if (!cellsOf(lx, ly, lz, hx, hy, hz, range)) {
       for (std::size_t t = 0; t < triangles; ++t) {
-        float tlo[3], thi[3];
+        Vec3 tlo, thi;
         grownBox(static_cast<std::uint32_t>(t), tlo, thi);
-        if (overlaps(tlo, thi)) consider(q, p, static_cast<std::uint32_t>(t), false);
+        if (overlaps(tlo.data(), thi.data())) consider(q, p, static_cast<std::uint32_t>(t), false);
       }
       continue;
     }
@@ -360,9 +353,9 @@ void Cape::findSelfContacts() {
           }
         }
     for (const std::uint32_t t : largeTriangles_) {
-      float tlo[3], thi[3];
+      Vec3 tlo, thi;
       grownBox(t, tlo, thi);
-      if (overlaps(tlo, thi)) consider(q, p, t, false);
+      if (overlaps(tlo.data(), thi.data())) consider(q, p, t, false);
     }
   }
 }
