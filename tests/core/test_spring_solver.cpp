@@ -134,10 +134,9 @@ KernelState jittered(const Fabric& fabric, unsigned seed) {
   st.z[5] = st.z[4];
   st.x[n / 2] = std::numeric_limits<float>::quiet_NaN();
   st.lambda.assign(fabric.springCount(), 0.0f);
-  std::size_t k = 0;
   for (int family = 0; family < kSpringFamilyCount; ++family) {
     const SpringSet& set = fabric.springs(static_cast<SpringFamily>(family));
-    for (std::size_t s = 0; s < set.size(); ++s, ++k) {
+    for (std::size_t s = 0; s < set.size(); ++s) {
       const float wsum = st.w[set.first[s]] + st.w[set.second[s]];
       st.invDenominator.push_back(wsum > 0.0f ? 1.0f / (wsum + 0.3f) : 0.0f);
     }

@@ -81,7 +81,7 @@ SpringLayout blockLayout(const SpringSet& set, std::size_t s) {
   return SpringLayout::Gathered;
 }
 
-// Cuts each colour into blocks of four that follow a vector layout, the springs between them scalar. Blocks
+// Cuts each colour into blocks of four (each with its vector layout) and a scalar tail of up to three. Blocks
 // never straddle two colours (the four springs of a block must share no particle); consecutive blocks of one
 // layout, and consecutive scalar springs, share a run, since a run is solved block after block in order.
 void planRuns(SpringSet& set) {

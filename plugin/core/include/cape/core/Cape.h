@@ -129,8 +129,8 @@ class Cape {
   double selfContactsValidUntil_ = -1.0;     ///< s: the contacts cover the motion until this time.
   std::uint64_t selfSearches_ = 0;           ///< Searches so far (diagnostics).
   std::vector<std::uint32_t> hashStart_;     ///< Spatial hash: bucket offsets (buckets + 1).
-  /// A triangle in a bucket of the spatial hash, with its grown box inline: the search reads entries in order
-  /// and rejects most by the box without touching the triangle.
+  /// A cluster of triangles in a bucket of the spatial hash, with its grown box inline: the search reads
+  /// entries in order and rejects most by the box without touching the triangles.
   struct alignas(16) HashEntry {
     float lo[4];  ///< [3]: the cluster's index, as float bits
     float hi[4];  ///< [3]: +inf

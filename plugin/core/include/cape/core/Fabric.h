@@ -16,10 +16,11 @@ enum class SpringFamily : int { Structural = 0, Shear = 1, Bend = 2 };
 constexpr int kSpringFamilyCount = 3;
 const char* toString(SpringFamily family);
 
-/// How the solver reads the particles of a run of springs. Four consecutive springs whose indices follow one
-/// of the vector patterns below are solved together with vector loads and stores of whole neighbourhoods
-/// (the grid's rows, columns and diagonals fall into them); anything else one spring at a time. With p the
-/// first particle of the block and q its second:
+/// How the solver reads the particles of a run of springs. Every block of four consecutive springs of one
+/// colour is solved four at a time: with vector loads and stores of whole neighbourhoods where the indices
+/// follow one of the patterns below (the grid's rows, columns and diagonals fall into them), gathered
+/// otherwise; the last one to three springs of a colour one at a time. With p the first particle of the
+/// block and q its second:
 enum class SpringLayout : std::uint8_t {
   Scalar,       ///< Any indices, one spring at a time.
   Contiguous,   ///< first p, p+1, p+2, p+3; second q, q+1, q+2, q+3 (a grid's columns and diagonals).
