@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cmath>
+#include <cinttypes>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -175,6 +176,12 @@ int main(int argc, char** argv) {
   summary["seconds"] = length;
   summary["settings"] = settingsJson(settingsForScene(o.scene, o.settings));
   summary["summary"] = summaryFigures(rows, q);
+  // Each cape's final state (stateHash: the bits of its positions and velocities), for determinism checks.
+  for (int k = 0; k < run->characterCount(); ++k) {
+    char hex[32];
+    std::snprintf(hex, sizeof hex, "%016" PRIx64, stateHash(run->cape(k).state()));
+    summary["state_hashes"].push_back(hex);
+  }
   if (run->characterCount() > 1) {
     for (std::size_t k = 0; k < recorders.size(); ++k) {
       std::vector<FrameRow> own;

@@ -1,0 +1,48 @@
+// Stored determinism hashes of the canonical scenes on the simple body: a refactor of the solver must keep
+// every bit of them. A change of behaviour on purpose updates the table in the same commit and says why in
+// its message. (Hashes are of this toolchain's IEEE single-precision arithmetic with -ffp-contract=off: the
+// same on every x86-64 build of the core, Release or Debug.)
+#include "cape/core/Scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cinttypes>
+#include <cstdio>
+
+namespace cape {
+namespace {
+
+struct StoredScene {
+  SceneKind kind;
+  bool selfCollision;
+  std::uint64_t hash;
+};
+
+// 20 x 20 canonical cape, corner attachment, default settings, 180 frames of 1/60 s (a sprint-turn's first
+// turn is in frames 90..120).
+constexpr StoredScene kStored[] = {
+    {SceneKind::Hang, false, 0x36e983342aa5d54bull},       {SceneKind::Hang, true, 0x36e983342aa5d54bull},
+    {SceneKind::Walk, false, 0xe42e25e81ef47c26ull},       {SceneKind::Walk, true, 0xe42e25e81ef47c26ull},
+    {SceneKind::SprintTurn, false, 0xe4943c86c51ce854ull}, {SceneKind::SprintTurn, true, 0xd29ff20f3bcb0175ull},
+    {SceneKind::Wind, false, 0x7132717a08c6698aull},       {SceneKind::Wind, true, 0x6fafb93a52a5ffc7ull},
+};
+
+std::uint64_t runScene(SceneKind kind, bool selfCollision) {
+  CapeSettings settings;
+  settings.selfCollision = selfCollision;
+  SimpleScene scene(kind, 20, Attachment::Corners, settingsForScene(kind, settings));
+  EXPECT_TRUE(scene.status().ok());
+  for (int f = 0; f < 180; ++f) scene.advanceFrame();
+  return stateHash(scene.cape().state());
+}
+
+TEST(StoredHashes, EveryCanonicalSceneKeepsItsBits) {
+  for (const StoredScene& s : kStored) {
+    const std::uint64_t h = runScene(s.kind, s.selfCollision);
+    EXPECT_EQ(h, s.hash) << toString(s.kind) << (s.selfCollision ? " with" : " without")
+                         << " self-collision: 0x" << std::hex << h;
+  }
+}
+
+}  // namespace
+}  // namespace cape

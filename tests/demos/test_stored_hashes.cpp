@@ -1,0 +1,39 @@
+// Stored determinism hashes of the Bullet walk, as cape_walk runs it: the shipped humanoid and the simple
+// body, each a 20 x 20 cape pinned by its corners, stepped by stepSimulation(1/60, 8, 1/240) for 2 s, in the
+// walk and, with self-collision (which the walk never needs), the sprint-turn's first turn. The whole path is in them: the character, the adapter's discovery, pins and
+// collider conversion, and the core step. A change of behaviour on purpose updates the table in the same
+// commit, saying why.
+#include "DemoTestSupport.h"
+
+#include <nlohmann/json.hpp>
+
+namespace cape::demo_test {
+namespace {
+
+struct StoredRun {
+  const char* arguments;
+  const char* hash;  ///< summary.json's state_hashes[0]
+};
+
+constexpr StoredRun kStored[] = {
+    {"--scene walk", "c8098390a000c0a5"},
+    {"--scene sprint-turn --self-collision", "585d8dce6c994280"},
+    {"--simple-body --scene walk", "1d271fe99adffc58"},
+    {"--simple-body --scene sprint-turn --self-collision", "7eebf81250cde109"},
+};
+
+TEST(StoredHashes, TheBulletWalkKeepsItsBits) {
+  const std::filesystem::path dir = freshDir();
+  int k = 0;
+  for (const StoredRun& s : kStored) {
+    const std::filesystem::path out = dir / std::to_string(k++);
+    const Result r = run(std::string(CAPE_WALK) + " " + s.arguments + " --seconds 2 --no-frames --out " + out.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::ifstream in(out / "summary.json");
+    const nlohmann::json summary = nlohmann::json::parse(in);
+    EXPECT_EQ(summary["state_hashes"][0].get<std::string>(), s.hash) << s.arguments;
+  }
+}
+
+}  // namespace
+}  // namespace cape::demo_test
