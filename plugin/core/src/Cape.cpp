@@ -2,6 +2,7 @@
 
 #include "cape/core/Wind.h"
 
+#include "CapeScratch.h"
 #include "SpringSolver.h"
 
 #include <algorithm>
@@ -46,6 +47,17 @@ static float explicitStableStep(const Fabric& fabric, const CapeSettings& settin
   return lambdaMax > 0.0f ? 2.0f / std::sqrt(lambdaMax) : kInf;
 }
 
+detail::CapeScratch::CapeScratch(const Fabric& fabric) : body(fabric.particleCount()), self(fabric) {
+  const Eigen::Index n = static_cast<Eigen::Index>(fabric.particleCount());
+  startPositions = Points::Zero(n, 3);
+  acceleration = Points::Zero(n, 3);
+  airVelocity = Points::Zero(n, 3);
+  freeMask = Eigen::VectorXf::Ones(n);
+  lambda = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.springCount()));
+  invDenominator = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.springCount()));
+  selfWeight = Eigen::VectorXf::Zero(n);
+}
+
 Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement)
     : fabric_(std::move(fabric)), settings_(settings) {
   if (!fabric_) {
@@ -65,114 +77,23 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
     state_.positions.row(i) = (r * fabric_->restPositions().row(i).transpose() + placement.position).transpose();
   state_.velocities = Points::Zero(n, 3);
   state_.inverseMasses = fabric_->masses().cwiseInverse();
-  startPositions_ = state_.positions;
-  acceleration_ = Points::Zero(n, 3);
-  freeMask_ = Eigen::VectorXf::Ones(n);
-  lambda_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric_->springCount()));
-  invDenominator_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric_->springCount()));
-  airVelocity_ = Points::Zero(n, 3);
-  // Each particle's share of the cloth's rest area (a third of each triangle it belongs to), m^2: the
-  // seed's sine-wave wind pushes on it.
-  particleArea_ = Eigen::VectorXf::Zero(n);
-  const std::vector<std::uint32_t>& tri = fabric_->triangles();
-  const Points& rest = fabric_->restPositions();
-  for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
-    const Vec3 a = rest.row(tri[t]).transpose(), b = rest.row(tri[t + 1]).transpose(), c = rest.row(tri[t + 2]).transpose();
-    const float third = (b - a).cross(c - a).norm() / 6.0f;
-    for (int k = 0; k < 3; ++k) particleArea_[tri[t + static_cast<std::size_t>(k)]] += third;
-  }
-  colliderEnd_.reserve(64);
-  // Self-collision scratch: a hash of at least twice as many buckets as particles (a power of two).
-  std::uint32_t buckets = 1;
-  while (buckets < 2 * static_cast<std::uint32_t>(n)) buckets <<= 1;
-  hashStart_.assign(buckets + 1, 0u);
-  bucketCluster_.assign(buckets, ~0u);
-  hashEntries_.assign(8 * fabric_->triangleCount(), HashEntry{});
-  bucketHits_.assign(hashEntries_.size(), 0u);
-  triangleMotion_.assign(fabric_->triangleCount(), 0.0f);
-  {
-    // The far corners across each triangle's edges: sort the edges (as vertex pairs) to meet each one's
-    // two triangles. An edge of more than two triangles (a non-manifold mesh) gets no wings.
-    struct HalfEdge {
-      std::uint64_t key;
-      std::uint32_t slot;  // 3 * triangle + edge
-      std::uint32_t far;
-    };
-    std::vector<HalfEdge> edges;
-    edges.reserve(tri.size());
-    for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
-      for (std::size_t k = 0; k < 3; ++k) {
-        const std::uint32_t u = tri[t + k], v = tri[t + (k + 1) % 3], far = tri[t + (k + 2) % 3];
-        const std::uint64_t key = (static_cast<std::uint64_t>(std::min(u, v)) << 32) | std::max(u, v);
-        edges.push_back({key, static_cast<std::uint32_t>(t + k), far});
-      }
-    }
-    std::sort(edges.begin(), edges.end(), [](const HalfEdge& a, const HalfEdge& b) {
-      return a.key != b.key ? a.key < b.key : a.slot < b.slot;
-    });
-    LocalSet none;
-    std::fill(std::begin(none.v), std::end(none.v), ~0u);
-    triangleLocal_.assign(fabric_->triangleCount(), none);
-    for (std::size_t t = 0; t < triangleLocal_.size(); ++t)
-      for (std::size_t k = 0; k < 3; ++k) triangleLocal_[t].v[k] = tri[3 * t + k];
-    for (std::size_t i = 0; i < edges.size();) {
-      std::size_t j = i;
-      while (j < edges.size() && edges[j].key == edges[i].key) ++j;
-      if (j - i == 2) {  // slot = 3 * triangle + edge: the wing goes to v[3 + edge]
-        triangleLocal_[edges[i].slot / 3].v[3 + edges[i].slot % 3] = edges[i + 1].far;
-        triangleLocal_[edges[i + 1].slot / 3].v[3 + edges[i + 1].slot % 3] = edges[i].far;
-      }
-      i = j;
-    }
-  }
-  triangleStamp_.assign(fabric_->triangleCount(), 0u);
-  largeTriangles_.reserve(fabric_->triangleCount());
-  triangleBuckets_.reserve(8 * fabric_->triangleCount());
-  // Clusters: consecutive triangles that share an edge go in pairs (a grid's cells come out as pairs).
-  clusterStart_.assign(1, 0u);
-  for (std::size_t t = 0; t < fabric_->triangleCount();) {
-    std::size_t next = t + 1;
-    if (next < fabric_->triangleCount()) {
-      int shared = 0;
-      for (std::size_t i = 0; i < 3; ++i)
-        for (std::size_t j = 0; j < 3; ++j) shared += tri[3 * t + i] == tri[3 * next + j] ? 1 : 0;
-      if (shared == 2) ++next;
-    }
-    clusterStart_.push_back(static_cast<std::uint32_t>(next));
-    t = next;
-  }
-  clusterBoxes_.assign(6 * (clusterStart_.size() - 1), 0.0f);
-  // The particles local to every triangle of a cluster (at most four kept): the first triangle's local set,
-  // less what the others lack.
-  ClusterLocal noLocal;
-  std::fill(std::begin(noLocal.v), std::end(noLocal.v), ~0u);
-  clusterLocal_.assign(clusterStart_.size() - 1, noLocal);
-  for (std::size_t g = 0; g + 1 < clusterStart_.size(); ++g) {
-    std::size_t kept = 0;
-    for (const std::uint32_t q : triangleLocal_[clusterStart_[g]].v) {
-      if (q == ~0u || kept == 4) continue;
-      bool inAll = true;
-      for (std::uint32_t t = clusterStart_[g] + 1; t < clusterStart_[g + 1]; ++t)
-        inAll = inAll && std::find(std::begin(triangleLocal_[t].v), std::end(triangleLocal_[t].v), q) != std::end(triangleLocal_[t].v);
-      if (inAll) clusterLocal_[g].v[kept++] = q;
-    }
-  }
-  triangleBucketStart_.assign(clusterStart_.size(), 0u);
-  stepMotion_ = Points::Zero(n, 3);
-  stepMotionNorm_ = Eigen::VectorXf::Zero(n);
-  selfWeight_ = Eigen::VectorXf::Zero(n);
-  selfContacts_.reserve(static_cast<std::size_t>(32 * n));
-  {
-    const SpringSet& structural = fabric_->springs(SpringFamily::Structural);
-    double sum = 0.0;
-    for (float l : structural.restLength) sum += l;
-    meanSpacing_ = structural.size() > 0 ? static_cast<float>(sum / static_cast<double>(structural.size())) : 0.01f;
-  }
-  contacts_.reserve(static_cast<std::size_t>(4 * n));
-  distance2_.resize(n);
-  candidates_.reserve(static_cast<std::size_t>(n));
   state_.pins.reserve(static_cast<std::size_t>(n));
+  work_ = std::make_unique<detail::CapeScratch>(*fabric_);
+  work_->startPositions = state_.positions;
 }
+
+Cape::~Cape() = default;
+Cape::Cape(Cape&&) noexcept = default;
+Cape& Cape::operator=(Cape&&) noexcept = default;
+
+float Cape::selfCollisionThickness() const { return work_ ? work_->self.thickness(settings_) : 0.0f; }
+
+const std::vector<Cape::SelfContact>& Cape::selfContacts() const {
+  static const std::vector<SelfContact> none;
+  return work_ ? work_->self.contacts() : none;
+}
+
+std::uint64_t Cape::selfContactSearches() const { return work_ ? work_->self.searches() : 0; }
 
 Status Cape::setSettings(const CapeSettings& settings) {
   Status s = settings.validate();
@@ -187,7 +108,6 @@ Status Cape::setSettings(const CapeSettings& settings) {
     }
   }
   settings_ = settings;
-  familyCompliance_.assign(kSpringFamilyCount, 0.0f);
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const float k = stiffnessOf(settings_, f);
     familyCompliance_[static_cast<std::size_t>(f)] = k > 0.0f ? 1.0f / k : kInf;  // inf compliance = off
@@ -238,6 +158,26 @@ void Cape::teleport(const Pose& delta) {
 
 void Cape::step(float dt, ColliderSpan colliders) {
   if (!ok() || !std::isfinite(dt) || !(dt > 0.0f)) return;
+  const StepPlan plan = planSubsteps(dt);
+  beginStep(plan, dt);
+  int searchEvery = 0;  // substeps between self-contact searches inside the loop; 0: none there
+  if (settings_.selfCollision && settings_.integrator == Integrator::Xpbd)
+    searchEvery = work_->self.schedule(state_, work_->freeMask, settings_, dt, plan.substeps);
+  for (int k = 0; k < plan.substeps; ++k) {
+    if (searchEvery > 0 && k % searchEvery == 0)
+      work_->self.searchFor(state_, work_->freeMask, settings_,
+                            plan.h * static_cast<float>(std::min(searchEvery, plan.substeps - k)));
+    const float s0 = static_cast<float>(k) / static_cast<float>(plan.substeps);
+    const float s1 = static_cast<float>(k + 1) / static_cast<float>(plan.substeps);
+    if (settings_.integrator == Integrator::Xpbd)
+      substepXpbd(plan.h, s0, s1, colliders);
+    else
+      substepExplicit(plan.h, s0, s1, colliders);
+  }
+  endStep(dt);
+}
+
+Cape::StepPlan Cape::planSubsteps(float dt) const {
   // settings.substeps are per settings.timeStep: a step of another length keeps the substep length, so a
   // world stepping at 1/240 s takes one substep where a 1/60 s frame takes three (the 1e-3 keeps dt =
   // timeStep at exactly `substeps` despite rounding).
@@ -249,54 +189,20 @@ void Cape::step(float dt, ColliderSpan colliders) {
     const float hMax = explicitStableStep(*fabric_, settings_);
     substeps = std::max(substeps, static_cast<int>(std::ceil(dt / (0.9f * hMax))));
   }
-  const float h = dt / static_cast<float>(substeps);
+  return {substeps, dt / static_cast<float>(substeps)};
+}
+
+void Cape::beginStep(const StepPlan& plan, float dt) {
   // 1 for free particles, 0 for pinned ones (same size every step: no allocation).
-  freeMask_ = (state_.inverseMasses.array() > 0.0f).cast<float>();
-  if (settings_.integrator == Integrator::Xpbd) prepareSpringDenominators(h);
+  work_->freeMask = (state_.inverseMasses.array() > 0.0f).cast<float>();
+  if (settings_.integrator == Integrator::Xpbd) prepareSpringDenominators(plan.h);
   // The air's velocity at each particle, once per step at its middle: gusts change over tenths of a second,
   // far slower than a frame.
   if (settings_.wind.model != WindSettings::Model::None)
-    windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt), airVelocity_);
-  // Self-contacts are found from where the cape is now and kept through the substeps. One search covers at
-  // most a spacing of motion (relative to the cape's rigid motion) and at most one settings.timeStep. A
-  // calm cape (no particle faster than a spacing per timeStep) searches once per timeStep: a world stepping
-  // at 1/240 s then searches once per 1/60 s, with that 1/60 s's motion bound. A faster one searches again
-  // every few substeps: a search over a whole fast frame would pair every particle with every triangle it
-  // might sweep past, and the substeps would carry thousands of contacts.
-  int searchEvery = 0;  // substeps between searches; 0: the contacts found earlier still cover this step
-  if (settings_.selfCollision && settings_.integrator == Integrator::Xpbd &&
-      state_.time + static_cast<double>(dt) > selfContactsValidUntil_ + 1e-9) {
-    // The fastest particle relative to the cape's rigid motion (predictSelfMotion), m/s.
-    const float fastest = predictSelfMotion(dt) / dt;
-    constexpr float kSearchMotion = 1.0f;  // spacings of motion one search may cover
-    if (std::isfinite(fastest) && fastest * settings_.timeStep < kSearchMotion * meanSpacing_) {
-      const float window = std::max(dt, settings_.timeStep);
-      if (window != dt) predictSelfMotion(window);
-      findSelfContacts();
-      ++selfSearches_;
-      selfContactsValidUntil_ = state_.time + static_cast<double>(window);
-    } else {
-      // Enough searches that none covers more than kSearchMotion spacings; every substep at most (and for a
-      // non-finite motion, whose search finds nothing: findSelfContacts leaves a blown-up cape alone).
-      const float wanted = fastest * dt / (kSearchMotion * meanSpacing_);
-      const int searches = std::isfinite(wanted) ? static_cast<int>(std::clamp(std::ceil(wanted), 1.0f, static_cast<float>(substeps))) : substeps;
-      searchEvery = (substeps + searches - 1) / searches;
-      selfContactsValidUntil_ = state_.time + static_cast<double>(dt);
-    }
-  }
-  for (int k = 0; k < substeps; ++k) {
-    if (searchEvery > 0 && k % searchEvery == 0) {
-      predictSelfMotion(h * static_cast<float>(std::min(searchEvery, substeps - k)));
-      findSelfContacts();
-      ++selfSearches_;
-    }
-    const float s0 = static_cast<float>(k) / static_cast<float>(substeps);
-    const float s1 = static_cast<float>(k + 1) / static_cast<float>(substeps);
-    if (settings_.integrator == Integrator::Xpbd)
-      stepXpbd(h, s0, s1, colliders);
-    else
-      stepExplicit(h, s0, s1, colliders);
-  }
+    windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt), work_->airVelocity);
+}
+
+void Cape::endStep(float dt) {
   for (Pin& p : state_.pins) p.previousTarget = p.target;
   state_.time += static_cast<double>(dt);
   adaptRefinement();
@@ -342,14 +248,15 @@ void Cape::movePinsTo(float s, float h) {
 
 void Cape::accumulateExternalAcceleration() {
   // Gravity on free particles only: pinned particles (inverse mass 0) feel nothing.
-  for (int c = 0; c < 3; ++c) acceleration_.col(c) = freeMask_ * settings_.gravity[c];
+  for (int c = 0; c < 3; ++c) work_->acceleration.col(c) = work_->freeMask * settings_.gravity[c];
   const WindSettings& wind = settings_.wind;
   if (wind.model == WindSettings::Model::SineWave) {
     // The seed's wind: quadratic drag of each particle's area share, whatever the cloth's orientation.
     const float q = 0.5f * wind.airDensity * wind.dragCoefficient;
+    const Eigen::VectorXf& areas = fabric_->particleAreas();
     for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
-      const Vec3 u = (airVelocity_.row(i) - state_.velocities.row(i)).transpose();
-      acceleration_.row(i) += (state_.inverseMasses[i] * q * particleArea_[i] * u.norm()) * u.transpose();
+      const Vec3 u = (work_->airVelocity.row(i) - state_.velocities.row(i)).transpose();
+      work_->acceleration.row(i) += (state_.inverseMasses[i] * q * areas[i] * u.norm()) * u.transpose();
     }
   } else if (wind.model == WindSettings::Model::Aerodynamic) {
     // Per triangle, from the air's velocity relative to the triangle (averages of its corners); a third of
@@ -357,8 +264,8 @@ void Cape::accumulateExternalAcceleration() {
     const std::vector<std::uint32_t>& tri = fabric_->triangles();
     const float *px = state_.positions.col(0).data(), *py = state_.positions.col(1).data(), *pz = state_.positions.col(2).data();
     const float *vx = state_.velocities.col(0).data(), *vy = state_.velocities.col(1).data(), *vz = state_.velocities.col(2).data();
-    const float *ux = airVelocity_.col(0).data(), *uy = airVelocity_.col(1).data(), *uz = airVelocity_.col(2).data();
-    float *ax = acceleration_.col(0).data(), *ay = acceleration_.col(1).data(), *az = acceleration_.col(2).data();
+    const float *ux = work_->airVelocity.col(0).data(), *uy = work_->airVelocity.col(1).data(), *uz = work_->airVelocity.col(2).data();
+    float *ax = work_->acceleration.col(0).data(), *ay = work_->acceleration.col(1).data(), *az = work_->acceleration.col(2).data();
     const float* w = state_.inverseMasses.data();
     const float rho = wind.airDensity, cd = wind.dragCoefficient, cl = wind.liftCoefficient;
     for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
@@ -379,38 +286,66 @@ void Cape::accumulateExternalAcceleration() {
   }
 }
 
-void Cape::stepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
-  startPositions_ = state_.positions;
-  accumulateExternalAcceleration();
-  // Predict: x* = x + h v + h^2 a (symplectic Euler on the external forces).
-  state_.velocities += h * acceleration_;
-  state_.positions += h * state_.velocities;
+void Cape::substepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
+  work_->startPositions = state_.positions;
+  predict(h);
   movePinsTo(s1, h);
-  // Constraints: tethers first (they fix the global stretch in one pass), then the springs, which are left
-  // with only local corrections. Collisions come last, so the cape ends every substep outside the colliders.
-  lambda_.setZero();
+  solveConstraints(h);
+  collideBodies(h, s0, s1, colliders, false);
+  if (settings_.selfCollision) solveSelfContactsAfterBodies();
+  updateVelocities(h);
+}
+
+void Cape::predict(float h) {
+  // x* = x + h v + h^2 a: symplectic Euler on the external forces.
+  accumulateExternalAcceleration();
+  state_.velocities += h * work_->acceleration;
+  state_.positions += h * state_.velocities;
+}
+
+void Cape::solveConstraints(float h) {
+  // Tethers first (they fix the global stretch in one pass), then the springs, which are left with only
+  // local corrections, then the self-contacts. Collisions come after, so the cape ends every substep outside
+  // the colliders.
+  work_->lambda.setZero();
   for (int it = 0; it < settings_.iterations; ++it) {
     if (settings_.useTethers) solveTethers();
     solveSprings(h);
-    if (settings_.selfCollision) solveSelfContacts(state_.inverseMasses.data());
+    if (settings_.selfCollision)
+      work_->self.solve(state_.positions, state_.inverseMasses.data(), work_->self.thickness(settings_));
   }
-  collide(h, s0, s1, colliders, false);
+}
+
+void Cape::collideBodies(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode) {
+  const detail::CollisionArrays p{state_.positions.col(0).data(),  state_.positions.col(1).data(),
+                                  state_.positions.col(2).data(),  work_->startPositions.col(0).data(),
+                                  work_->startPositions.col(1).data(), work_->startPositions.col(2).data(),
+                                  state_.inverseMasses.data(),     state_.velocities.col(0).data(),
+                                  state_.velocities.col(1).data(), state_.velocities.col(2).data(),
+                                  state_.positions.rows()};
+  work_->body.collide(p, settings_, h, s0, s1, colliders, explicitMode);
   // A particle wedged where two colliders meet (a shoulder sphere poking out of the torso box) is pushed out
   // of one into the other; a few Gauss-Seidel passes over the contacts settle it outside both.
-  for (int pass = 0; pass < kContactPasses; ++pass) reprojectContacts(colliders);
-  if (settings_.selfCollision) {
-    // Cloth pressed between a body and another layer of itself: the layer on the body cannot give way, so
-    // the outer layer takes the whole correction (mass scaling by contact).
-    selfWeight_ = state_.inverseMasses;
-    for (const Contact& k : contacts_) selfWeight_[k.particle] = 0.0f;
-    solveSelfContacts(selfWeight_.data());
-  }
+  for (int pass = 0; pass < kContactPasses; ++pass) work_->body.reproject(p, settings_, colliders);
+}
+
+void Cape::solveSelfContactsAfterBodies() {
+  // Cloth pressed between a body and another layer of itself: the layer on the body cannot give way, so
+  // the outer layer takes the whole correction (mass scaling by contact).
+  work_->selfWeight = state_.inverseMasses;
+  for (const Contact& k : work_->body.contacts()) work_->selfWeight[k.particle] = 0.0f;
+  work_->self.solve(state_.positions, work_->selfWeight.data(), work_->self.thickness(settings_));
+}
+
+void Cape::updateVelocities(float h) {
   // New velocities from the position change, then damping: dv/dt = -c v integrated implicitly
-  // (v <- v / (1 + c h), the Padé approximation of exp(-c h), unconditionally stable).
+  // (v <- v / (1 + c h), the Pade approximation of exp(-c h), unconditionally stable). Pinned particles keep
+  // the velocity their pin gave them.
   const float scale = 1.0f / (h * (1.0f + settings_.damping * h));
+  const Eigen::VectorXf& free = work_->freeMask;
   for (int c = 0; c < 3; ++c) {
-    state_.velocities.col(c) = freeMask_.cwiseProduct(state_.positions.col(c) - startPositions_.col(c)) * scale +
-                               (1.0f - freeMask_.array()).matrix().cwiseProduct(state_.velocities.col(c));
+    state_.velocities.col(c) = free.cwiseProduct(state_.positions.col(c) - work_->startPositions.col(c)) * scale +
+                               (1.0f - free.array()).matrix().cwiseProduct(state_.velocities.col(c));
   }
 }
 
@@ -419,7 +354,7 @@ void Cape::prepareSpringDenominators(float h) {
   // multiplies instead of dividing. 0 when both ends are pinned (no correction).
   const float invH2 = 1.0f / (h * h);
   const float* w = state_.inverseMasses.data();
-  float* out = invDenominator_.data();
+  float* out = work_->invDenominator.data();
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
     const float compliance = familyCompliance_[static_cast<std::size_t>(f)];
@@ -440,8 +375,8 @@ void Cape::solveSprings(float h) {
   arrays.py = state_.positions.col(1).data();
   arrays.pz = state_.positions.col(2).data();
   arrays.inverseMass = state_.inverseMasses.data();
-  arrays.lambda = lambda_.data();
-  arrays.invDenominator = invDenominator_.data();
+  arrays.lambda = work_->lambda.data();
+  arrays.invDenominator = work_->invDenominator.data();
   const float invH2 = 1.0f / (h * h);
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
@@ -463,15 +398,26 @@ void Cape::solveTethers() {
                        state_.inverseMasses.data(), fabric_->tethers());
 }
 
-void Cape::stepExplicit(float h, float s0, float s1, ColliderSpan colliders) {
+void Cape::substepExplicit(float h, float s0, float s1, ColliderSpan colliders) {
   // The seed: F = m g - m c v + sum of Hooke forces k (|d| - L) d / |d|; v += h F / m; x += h v.
   accumulateExternalAcceleration();
+  accumulateSpringForces();
+  for (int c = 0; c < 3; ++c)
+    work_->acceleration.col(c) -= settings_.damping * work_->freeMask.cwiseProduct(state_.velocities.col(c));
+  state_.velocities += h * work_->acceleration;
+  work_->startPositions = state_.positions;
+  state_.positions += h * state_.velocities;
+  movePinsTo(s1, h);
+  collideBodies(h, s0, s1, colliders, true);
+}
+
+void Cape::accumulateSpringForces() {
   const float* px = state_.positions.col(0).data();
   const float* py = state_.positions.col(1).data();
   const float* pz = state_.positions.col(2).data();
-  float* ax = acceleration_.col(0).data();
-  float* ay = acceleration_.col(1).data();
-  float* az = acceleration_.col(2).data();
+  float* ax = work_->acceleration.col(0).data();
+  float* ay = work_->acceleration.col(1).data();
+  float* az = work_->acceleration.col(2).data();
   const float* w = state_.inverseMasses.data();
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const float k = stiffnessOf(settings_, f);
@@ -491,15 +437,6 @@ void Cape::stepExplicit(float h, float s0, float s1, ColliderSpan colliders) {
       az[j] -= w[j] * fs * dz;
     }
   }
-  for (int c = 0; c < 3; ++c) {
-    acceleration_.col(c) -= settings_.damping * freeMask_.cwiseProduct(state_.velocities.col(c));
-  }
-  state_.velocities += h * acceleration_;
-  startPositions_ = state_.positions;
-  state_.positions += h * state_.velocities;
-  movePinsTo(s1, h);
-  collide(h, s0, s1, colliders, true);
-  for (int pass = 0; pass < kContactPasses; ++pass) reprojectContacts(colliders);
 }
 
 double Cape::energy() const {

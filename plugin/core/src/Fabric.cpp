@@ -278,7 +278,18 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
   }
   // Rest diameter from the bounding box diagonal: an upper bound on any rest distance.
   restDiameter_ = (restPositions_.colwise().maxCoeff() - restPositions_.colwise().minCoeff()).norm();
+  {
+    const SpringSet& structural = springs_[static_cast<int>(SpringFamily::Structural)];
+    double sum = 0.0;
+    for (float l : structural.restLength) sum += l;
+    meanSpacing_ = structural.size() > 0 ? static_cast<float>(sum / static_cast<double>(structural.size())) : 0.01f;
+  }
+  buildTriangleTables();
+  return buildTethers(anchors, tethersPerParticle, tetherScale);
+}
 
+Status Fabric::buildTethers(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale) {
+  const std::size_t n = particleCount();
   if (!anchors.empty()) {
     if (tethersPerParticle < 1) return Status::error("Fabric: tethersPerParticle must be >= 1");
     if (!(std::isfinite(tetherScale) && tetherScale >= 1.0f)) return Status::error("Fabric: tetherScale must be >= 1");
@@ -310,6 +321,82 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
     }
   }
   return Status::success();
+}
+
+void Fabric::buildTriangleTables() {
+  const std::vector<std::uint32_t>& tri = triangles_;
+  const std::size_t triangles = triangleCount();
+  // Each particle's share of the cloth's rest area: a third of each triangle it belongs to.
+  particleAreas_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(particleCount()));
+  for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
+    const Vec3 a = restPositions_.row(tri[t]).transpose(), b = restPositions_.row(tri[t + 1]).transpose(),
+               c = restPositions_.row(tri[t + 2]).transpose();
+    const float third = (b - a).cross(c - a).norm() / 6.0f;
+    for (int k = 0; k < 3; ++k) particleAreas_[tri[t + static_cast<std::size_t>(k)]] += third;
+  }
+  // The far corners across each triangle's edges: sort the edges (as vertex pairs) to meet each one's two
+  // triangles. An edge of more than two triangles (a non-manifold mesh) gets no wings.
+  struct HalfEdge {
+    std::uint64_t key;
+    std::uint32_t slot;  // 3 * triangle + edge
+    std::uint32_t far;
+  };
+  std::vector<HalfEdge> edges;
+  edges.reserve(tri.size());
+  for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t u = tri[t + k], v = tri[t + (k + 1) % 3], far = tri[t + (k + 2) % 3];
+      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(u, v)) << 32) | std::max(u, v);
+      edges.push_back({key, static_cast<std::uint32_t>(t + k), far});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const HalfEdge& a, const HalfEdge& b) {
+    return a.key != b.key ? a.key < b.key : a.slot < b.slot;
+  });
+  TriangleLocalSet none;
+  std::fill(std::begin(none.v), std::end(none.v), ~0u);
+  triangleLocal_.assign(triangles, none);
+  for (std::size_t t = 0; t < triangles; ++t)
+    for (std::size_t k = 0; k < 3; ++k) triangleLocal_[t].v[k] = tri[3 * t + k];
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+    if (j - i == 2) {  // slot = 3 * triangle + edge: the wing goes to v[3 + edge]
+      triangleLocal_[edges[i].slot / 3].v[3 + edges[i].slot % 3] = edges[i + 1].far;
+      triangleLocal_[edges[i + 1].slot / 3].v[3 + edges[i + 1].slot % 3] = edges[i].far;
+    }
+    i = j;
+  }
+  // Clusters: consecutive triangles that share an edge go in pairs (a grid's cells come out as pairs).
+  clusterStart_.assign(1, 0u);
+  for (std::size_t t = 0; t < triangles;) {
+    std::size_t next = t + 1;
+    if (next < triangles) {
+      int shared = 0;
+      for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) shared += tri[3 * t + i] == tri[3 * next + j] ? 1 : 0;
+      if (shared == 2) ++next;
+    }
+    clusterStart_.push_back(static_cast<std::uint32_t>(next));
+    t = next;
+  }
+  // The particles local to every triangle of a cluster (at most four kept): the first triangle's local set,
+  // less what the others lack.
+  ClusterLocalSet noLocal;
+  std::fill(std::begin(noLocal.v), std::end(noLocal.v), ~0u);
+  clusterLocal_.assign(clusterCount(), noLocal);
+  for (std::size_t g = 0; g < clusterCount(); ++g) {
+    std::size_t kept = 0;
+    for (const std::uint32_t q : triangleLocal_[clusterStart_[g]].v) {
+      if (q == ~0u || kept == 4) continue;
+      bool inAll = true;
+      for (std::uint32_t t = clusterStart_[g] + 1; t < clusterStart_[g + 1]; ++t) {
+        const std::uint32_t* v = triangleLocal_[t].v;
+        inAll = inAll && std::find(v, v + 8, q) != v + 8;
+      }
+      if (inAll) clusterLocal_[g].v[kept++] = q;
+    }
+  }
 }
 
 }  // namespace cape

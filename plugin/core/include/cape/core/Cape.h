@@ -1,5 +1,6 @@
-// Cape: one simulated cape — a shared Fabric, its own settings and state, and the solver's scratch memory,
-// sized once so that stepping never allocates.
+// Cape: one simulated cape — a shared Fabric, its own settings and state — and its staged step. The solver's
+// scratch memory (the step's buffers, the body- and self-collision subsystems) lives in the core's sources,
+// sized once when the cape is made, so that stepping never allocates.
 #pragma once
 
 #include "cape/core/CapeSettings.h"
@@ -7,10 +8,15 @@
 #include "cape/core/Collider.h"
 #include "cape/core/Fabric.h"
 
+#include <array>
 #include <memory>
 #include <vector>
 
 namespace cape {
+
+namespace detail {
+struct CapeScratch;
+}
 
 /// A view of the colliders for one step (the caller owns them; see Collider::moveTo).
 struct ColliderSpan {
@@ -28,6 +34,11 @@ class Cape {
   /// Makes a cape at the fabric's rest shape placed by `placement` (world = placement * rest), at rest.
   /// Check `status()`: on bad settings or fabric the cape is empty and step() does nothing.
   Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement = Pose());
+  ~Cape();
+  Cape(Cape&&) noexcept;
+  Cape& operator=(Cape&&) noexcept;
+  Cape(const Cape&) = delete;
+  Cape& operator=(const Cape&) = delete;
 
   const Status& status() const { return status_; }
   bool ok() const { return status_.ok(); }
@@ -70,7 +81,7 @@ class Cape {
   float lastMaxStrain() const { return lastMaxStrain_; }
 
   /// The self-collision thickness in use, m (the setting, or its automatic value).
-  float selfCollisionThickness() const { return selfThickness(); }
+  float selfCollisionThickness() const;
   /// A predictive self-contact (Lewin 2018): a particle near a triangle it does not belong to, found at the
   /// start of the step, with the side of the triangle it was on then (+1, -1, or 0 while its nearest point
   /// is on the triangle's boundary). The solver keeps it on that side, at least the thickness away.
@@ -80,89 +91,48 @@ class Cape {
     float side;
   };
   /// Self-contacts found by the last search (diagnostics, benchmarks and tests).
-  const std::vector<SelfContact>& selfContacts() const { return selfContacts_; }
-  std::size_t selfContactCount() const { return selfContacts_.size(); }
+  const std::vector<SelfContact>& selfContacts() const;
+  std::size_t selfContactCount() const { return selfContacts().size(); }
   /// Self-contact searches run so far (a search's contacts are kept over the steps its margin covers).
-  std::uint64_t selfContactSearches() const { return selfSearches_; }
+  std::uint64_t selfContactSearches() const;
 
   /// Sum over particles of kinetic and gravitational potential energy plus spring (Hooke) energy, J.
   double energy() const;
 
  private:
-  void stepXpbd(float h, float s0, float s1, ColliderSpan colliders);
-  void stepExplicit(float h, float s0, float s1, ColliderSpan colliders);
+  /// The substeps of one step: how many, and how long each is (s).
+  struct StepPlan {
+    int substeps = 1;
+    float h = 0.0f;
+  };
+  StepPlan planSubsteps(float dt) const;
+  void beginStep(const StepPlan& plan, float dt);
+  void endStep(float dt);
+  // The stages of one substep [s0, s1] (fractions of the step) of length h.
+  void substepXpbd(float h, float s0, float s1, ColliderSpan colliders);
+  void substepExplicit(float h, float s0, float s1, ColliderSpan colliders);
+  void predict(float h);
   void movePinsTo(float s, float h);
-  void adaptRefinement();
-  void collide(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode);
-  void reprojectContacts(ColliderSpan colliders);
+  void solveConstraints(float h);
+  void collideBodies(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode);
+  void solveSelfContactsAfterBodies();
+  void updateVelocities(float h);
+  // Their parts.
+  void accumulateExternalAcceleration();
+  void accumulateSpringForces();
   void prepareSpringDenominators(float h);
   void solveSprings(float h);
   void solveTethers();
-  void accumulateExternalAcceleration();
-  float predictSelfMotion(float dt);
-  void findSelfContacts();  ///< For the motion predictSelfMotion last predicted.
-  void solveSelfContacts(const float* inverseMasses);
-  float selfThickness() const;
+  void adaptRefinement();
 
   FabricPtr fabric_;
   CapeSettings settings_;
+  std::array<float, kSpringFamilyCount> familyCompliance_{};  ///< 1 / stiffness per family, m/N (inf: off).
   int refinement_ = 1;          ///< Substep multiplier of the next step (1, 2, 4, ...).
   float lastMaxStrain_ = 0.0f;  ///< Max structural strain after the last step.
   CapeState state_;
   Status status_ = Status::success();
-
-  // Scratch, sized once in the constructor.
-  Points startPositions_;        ///< Positions at the start of the substep.
-  Points acceleration_;          ///< External acceleration per particle (gravity + wind), m/s^2.
-  Eigen::VectorXf freeMask_;     ///< 1 for free particles, 0 for pinned, refreshed each step.
-  Eigen::VectorXf lambda_;       ///< XPBD Lagrange multipliers of every spring, per substep.
-  Eigen::VectorXf invDenominator_;  ///< 1 / (w_i + w_j + alpha~) of every spring, per step.
-  std::vector<float> familyCompliance_;
-  Points airVelocity_;           ///< The wind's velocity at each particle for this step, m/s.
-  Eigen::VectorXf particleArea_; ///< Each particle's share of the rest area, m^2 (the seed's wind).
-  std::vector<Pose> colliderEnd_;   ///< Collider poses at the end of the substep.
-  std::vector<Contact> contacts_;   ///< Contacts of the substep's collision pass.
-  Eigen::ArrayXf distance2_;        ///< Broad-phase scratch, one per particle.
-  std::vector<std::uint32_t> candidates_;  ///< Broad-phase scratch.
-
-  std::vector<SelfContact> selfContacts_;
-  double selfContactsValidUntil_ = -1.0;     ///< s: the contacts cover the motion until this time.
-  std::uint64_t selfSearches_ = 0;           ///< Searches so far (diagnostics).
-  std::vector<std::uint32_t> hashStart_;     ///< Spatial hash: bucket offsets (buckets + 1).
-  /// A cluster of triangles in a bucket of the spatial hash, with its grown box inline: the search reads
-  /// entries in order and rejects most by the box without touching the triangles.
-  struct alignas(16) HashEntry {
-    float lo[4];  ///< [3]: the cluster's index, as float bits
-    float hi[4];  ///< [3]: +inf
-  };
-  std::vector<HashEntry> hashEntries_;       ///< Spatial hash: clusters of triangles sorted by bucket.
-  std::vector<std::uint32_t> bucketHits_;    ///< Search scratch: one bucket's entries that overlap (hashEntries_ size).
-  /// The particles a triangle never makes contacts with: its corners and, for each edge, the far corner of
-  /// the triangle across it (~0u on the border); padded to 8 for a two-compare test.
-  struct alignas(16) LocalSet {
-    std::uint32_t v[8];
-  };
-  std::vector<LocalSet> triangleLocal_;
-  std::vector<float> triangleMotion_;        ///< Per triangle: the largest motion of its corners in the search, m.
-  std::vector<std::uint32_t> triangleStamp_; ///< Last particle that met each triangle in the search.
-  std::vector<std::uint32_t> largeTriangles_; ///< Triangles whose grown box is too big to bin.
-  /// Triangles binned together: cluster g is [clusterStart_[g], clusterStart_[g + 1]), two consecutive
-  /// triangles that share an edge (a grid cell's halves, whose boxes are the cell's) or one.
-  std::vector<std::uint32_t> clusterStart_;
-  std::vector<float> clusterBoxes_;                ///< Per cluster: the union of its grown boxes, m.
-  /// Per cluster: particles local to every one of its triangles (a grid cell's four corners; ~0u padding),
-  /// which meet nothing in it. Four, aligned for one compare.
-  struct alignas(16) ClusterLocal {
-    std::uint32_t v[4];
-  };
-  std::vector<ClusterLocal> clusterLocal_;
-  std::vector<std::uint32_t> triangleBuckets_;     ///< The buckets each binned cluster went into...
-  std::vector<std::uint32_t> triangleBucketStart_; ///< ...from this offset per cluster (clusters + 1).
-  std::vector<std::uint32_t> bucketCluster_;       ///< The last cluster binned into each bucket, per search.
-  Points stepMotion_;                        ///< Predicted displacement over the step, less a rigid motion, m.
-  Eigen::VectorXf selfWeight_;               ///< Inverse masses for the last self-contact pass, 1/kg.
-  Eigen::VectorXf stepMotionNorm_;           ///< |stepMotion_| per particle, m.
-  float meanSpacing_ = 0.0f;                 ///< Mean structural rest length, m (sizes the hash cells).
+  std::unique_ptr<detail::CapeScratch> work_;  ///< Sized once; null while the cape is not ok().
 };
 
 }  // namespace cape

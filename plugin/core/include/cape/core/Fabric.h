@@ -90,6 +90,20 @@ struct MeshDesc {
   float tetherScale = 1.0f;
 };
 
+/// The particles a triangle never makes self-contacts with: its three corners and, for each edge k, the far
+/// corner of the triangle across it in v[3 + k] (~0u on the border or a non-manifold edge); v[6], v[7] are
+/// ~0u padding, so that membership is two 4-lane compares.
+struct alignas(16) TriangleLocalSet {
+  std::uint32_t v[8];
+};
+
+/// Triangles the self-collision search bins together: two consecutive triangles sharing an edge (a grid
+/// cell's halves) or one alone. `local` holds the particles local to every triangle of the cluster (a grid
+/// cell's four corners; ~0u padding), which meet nothing in it.
+struct alignas(16) ClusterLocalSet {
+  std::uint32_t v[4];
+};
+
 class Fabric;
 using FabricPtr = std::shared_ptr<const Fabric>;
 
@@ -126,11 +140,30 @@ class Fabric {
   int gridRows() const { return gridRows_; }
   /// The largest distance between two particles at rest (bounds how far any particle can be from a pin).
   float restDiameter() const { return restDiameter_; }
+  /// Mean rest length of the structural springs, m (sizes the self-collision hash and thickness).
+  float meanSpacing() const { return meanSpacing_; }
+  /// Each particle's share of the rest area (a third of each triangle it belongs to), m^2.
+  const Eigen::VectorXf& particleAreas() const { return particleAreas_; }
+  /// Per triangle, the particles it never makes self-contacts with.
+  const std::vector<TriangleLocalSet>& triangleLocal() const { return triangleLocal_; }
+  /// Cluster g is triangles [clusterStart()[g], clusterStart()[g + 1]) (clusterCount() + 1 offsets).
+  const std::vector<std::uint32_t>& clusterStart() const { return clusterStart_; }
+  std::size_t clusterCount() const { return clusterStart_.empty() ? 0 : clusterStart_.size() - 1; }
+  const std::vector<ClusterLocalSet>& clusterLocal() const { return clusterLocal_; }
 
  private:
   Fabric() = default;
-  /// Derived data in one explicit pass: rest lengths, tethers, diameter. Returns an error on degenerate input.
+  /// Derived data in one explicit pass: colouring and runs, rest lengths, diameter, spacing, tethers, the
+  /// triangle tables. Returns an error on degenerate input.
   Status finish(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale);
+  Status buildTethers(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale);
+  void buildTriangleTables();
+
+  float meanSpacing_ = 0.0f;
+  Eigen::VectorXf particleAreas_;
+  std::vector<TriangleLocalSet> triangleLocal_;
+  std::vector<std::uint32_t> clusterStart_;
+  std::vector<ClusterLocalSet> clusterLocal_;
 
   Points restPositions_;
   Eigen::VectorXf masses_;

@@ -1,0 +1,292 @@
+// The collision stage of a substep: every free particle against every collider's sweep over the substep.
+#include "BodyCollision.h"
+
+#include "ShapeDistance.h"
+
+#include <cmath>
+#include <limits>
+
+namespace cape::detail {
+
+namespace {
+
+// Radius of a sphere about the collider's origin that holds the whole shape (infinite for planes).
+float boundingRadius(const Collider& c) {
+  switch (c.shape) {
+    case ColliderShape::Sphere: return c.radius;
+    case ColliderShape::Capsule: return c.radius + c.halfHeight;
+    case ColliderShape::Cylinder: return std::hypot(c.radius, c.halfHeight);
+    case ColliderShape::Box: return c.halfExtents.norm();
+    case ColliderShape::Plane: return std::numeric_limits<float>::infinity();
+  }
+  return std::numeric_limits<float>::infinity();
+}
+
+/// What one collider's pass needs besides the particles.
+struct PassArrays {
+  std::vector<Cape::Contact>* contacts;
+  std::uint32_t collider;
+  float maxTravel;                         ///< the largest distance any particle moved in this substep, m
+  Eigen::ArrayXf* distance2;               ///< scratch, one per particle
+  std::vector<std::uint32_t>* candidates;  ///< scratch
+};
+
+/// One collider's motion over the substep: its poses at s0 (A) and s1 (B), and bounds of how far a point at
+/// rest in the world moves relative to it.
+struct Sweep {
+  Pose A, B;
+  Eigen::Matrix3f invRA, invRB, RB;
+  float bound;   ///< radius about the collider's origin holding the shape, m (inf for planes)
+  float shift;   ///< |B.position - A.position|, m
+  float turn;    ///< rotation angle from A to B, rad
+  float margin;  ///< the cape's thickness plus the collider's, m
+  Sweep(const Collider& c, float s0, float s1, float margin_)
+      : A(Pose::interpolate(c.previous, c.current, s0)), B(Pose::interpolate(c.previous, c.current, s1)),
+        invRA(A.rotation.conjugate().toRotationMatrix()), invRB(B.rotation.conjugate().toRotationMatrix()),
+        RB(B.rotation.toRotationMatrix()), bound(boundingRadius(c)), shift((B.position - A.position).norm()),
+        turn(A.rotation.angularDistance(B.rotation)), margin(margin_) {}
+};
+
+/// Broad phase, vectorised over all particles: the free particles that could reach the collider (a lower
+/// bound of the distance to its shape, or to the plane) within this substep go on to the exact test.
+template <ColliderShape S>
+void gatherCandidates(const Collider& c, const CollisionArrays& p, const PassArrays& q, const Sweep& w) {
+  Eigen::Map<const Eigen::ArrayXf> X(p.px, p.n), Y(p.py, p.n), Z(p.pz, p.n);
+  Eigen::ArrayXf& d2 = *q.distance2;
+  float reach = std::numeric_limits<float>::infinity();
+  if constexpr (S == ColliderShape::Plane) {
+    const Vec3 nw = w.B.rotation * c.normal;
+    const float cw = c.constant + nw.dot(w.B.position);
+    d2 = X * nw.x() + Y * nw.y() + Z * nw.z() - cw;  // signed distance to the plane at s1
+    reach = w.turn > 0.0f ? std::numeric_limits<float>::infinity() : w.margin + w.shift + q.maxTravel;
+  } else if (w.turn < 0.5f) {
+    // In the collider's frame at s1, a lower bound of each particle's signed distance to the shape (exact
+    // for spheres, capsules and inside boxes and cylinders; the largest axis gap outside them), less the
+    // most it can move relative to the collider in this substep: the narrow phase's test with every
+    // particle's travel replaced by the largest, so it keeps every particle that test could keep. A plain
+    // loop over flat arrays, vectorised by the compiler. The slack (0.1 mm) covers the rounding of a
+    // different evaluation order.
+    constexpr float kSlack = 1e-4f;
+    Eigen::Matrix3f M = w.invRB;
+    if constexpr (S == ColliderShape::Capsule || S == ColliderShape::Cylinder) {
+      if (c.axis != 0) M.row(0).swap(M.row(c.axis));  // row 0 along the axis, rows 1 and 2 across it
+    }
+    const float m00 = M(0, 0), m01 = M(0, 1), m02 = M(0, 2), m10 = M(1, 0), m11 = M(1, 1), m12 = M(1, 2);
+    const float m20 = M(2, 0), m21 = M(2, 1), m22 = M(2, 2);
+    const float ox = w.B.position.x(), oy = w.B.position.y(), oz = w.B.position.z();
+    const float hx = c.halfExtents.x(), hy = c.halfExtents.y(), hz = c.halfExtents.z();
+    const float radius = c.radius, halfHeight = c.halfHeight, turn = w.turn;
+    const float fixedReach = w.margin + w.shift + q.maxTravel * (1.0f + turn) + kSlack;
+    const float* __restrict px = p.px;
+    const float* __restrict py = p.py;
+    const float* __restrict pz = p.pz;
+    float* __restrict gap = d2.data();
+    for (Eigen::Index i = 0; i < p.n; ++i) {
+      const float rx = px[i] - ox, ry = py[i] - oy, rz = pz[i] - oz;
+      const float relNorm = std::sqrt(rx * rx + ry * ry + rz * rz);
+      float lower;
+      if constexpr (S == ColliderShape::Sphere) {
+        lower = relNorm - radius;
+      } else {
+        const float b0 = m00 * rx + m01 * ry + m02 * rz;
+        const float b1 = m10 * rx + m11 * ry + m12 * rz;
+        const float b2 = m20 * rx + m21 * ry + m22 * rz;
+        if constexpr (S == ColliderShape::Box) {
+          lower = std::max(std::max(std::abs(b0) - hx, std::abs(b1) - hy), std::abs(b2) - hz);
+        } else if constexpr (S == ColliderShape::Capsule) {
+          const float beyond = std::abs(b0) - halfHeight;  // past the end of the segment, along the axis
+          const float along = 0.5f * (beyond + std::abs(beyond));  // max(beyond, 0), exactly, without a branch
+          lower = std::sqrt(along * along + b1 * b1 + b2 * b2) - radius;
+        } else {
+          lower = std::max(std::sqrt(b1 * b1 + b2 * b2) - radius, std::abs(b0) - halfHeight);
+        }
+      }
+      gap[i] = lower - (fixedReach + turn * relNorm);
+    }
+    reach = 0.0f;
+  } else {
+    // Turning too fast to bound: every particle at a finite distance goes on to the exact test.
+    d2 = (X - w.B.position.x()).square() + (Y - w.B.position.y()).square() + (Z - w.B.position.z()).square();
+  }
+  std::vector<std::uint32_t>& candidates = *q.candidates;
+  candidates.clear();
+  for (Eigen::Index i = 0; i < p.n; ++i)
+    if (d2[i] <= reach && p.w[i] != 0.0f) candidates.push_back(static_cast<std::uint32_t>(i));
+}
+
+/// The narrow phase of one particle, in the collider's frame: it moves from a (its start, in the frame at
+/// s0) to b (its prediction, in the frame at s1). Returns whether it touched; then `bn` is where it ends,
+/// outside the skin, and `normal` the contact normal.
+template <ColliderShape S>
+bool resolveSweep(const Collider& c, float margin, const Vec3& a, const Vec3& b, const SurfaceDistance& sb, Vec3& bn,
+                  Vec3& normal) {
+  const SurfaceDistance sa = shapeDistance<S>(c, a);
+  bn = b;
+  normal = sb.normal;
+  bool touched = false;
+  const Vec3 ab = b - a;
+  const float len = ab.norm();
+  // Started clear and either ended inside the skin or moved far enough to tunnel through a thin part
+  // (along the segment d >= (d(a) + d(b) - len) / 2): conservative advancement from a finds the first
+  // contact, and the particle leaves through the face it came in by — not through whichever face is
+  // nearest to where it ended, which near a box's edge would tear neighbouring particles apart.
+  if (sa.distance >= margin && sa.distance + sb.distance - len < 2.0f * margin) {
+    float t = 0.0f;
+    SurfaceDistance s = sa;
+    bool hit = false;
+    for (int iter = 0; iter < 32; ++iter) {
+      const float gap = s.distance - margin;
+      if (gap < 1e-5f) {
+        hit = true;
+        break;
+      }
+      // The rest of the segment clears the margin: no contact.
+      if (s.distance + sb.distance - (1.0f - t) * len >= 2.0f * margin) break;
+      t += gap / len;
+      if (t >= 1.0f) break;
+      s = shapeDistance<S>(c, a + t * ab);
+    }
+    if (hit) {
+      // Stop at the contact: keep only the motion along the tangent plane of the contact point.
+      const Vec3 pc = a + t * ab;
+      normal = s.normal;
+      bn = b + std::max(0.0f, (pc - b).dot(normal)) * normal;
+      touched = true;
+    }
+  }
+  // Whatever the sweep found, end outside the skin: push out to the nearest surface point plus the margin
+  // (the seed's push-out; it also covers particles that started inside, e.g. after a pose jump).
+  const SurfaceDistance sn = touched ? shapeDistance<S>(c, bn) : sb;
+  if (sn.distance < margin) {
+    bn += (margin - sn.distance) * sn.normal;
+    if (!touched) normal = sn.normal;
+    touched = true;
+  }
+  return touched;
+}
+
+/// Coulomb friction on the tangential displacement relative to the collider (Macklin et al. 2014, "Unified
+/// Particle Physics for Real-Time Applications"): static while within mu times the normal correction,
+/// otherwise shortened by that much.
+inline void applyFriction(float mu, const Vec3& a, const Vec3& b, const Vec3& normal, Vec3& bn) {
+  const float normalCorrection = (bn - b).norm();
+  if (mu > 0.0f && normalCorrection > 0.0f) {
+    const Vec3 moved = bn - a;
+    const Vec3 tangential = moved - moved.dot(normal) * normal;
+    const float tl = tangential.norm();
+    const float limit = mu * normalCorrection;
+    bn -= tl <= limit ? tangential : Vec3(tangential * (limit / tl));
+  }
+}
+
+/// One collider against every free particle. In the collider's own frame the collider is still and the
+/// particle moves from its start to its prediction: relative motion, so a fast collider and a fast particle
+/// are the same problem.
+template <ColliderShape S>
+__attribute__((flatten)) void collideWith(const Collider& c, const CollisionArrays& p, const PassArrays& q, float s0,
+                                          float s1, float margin, float mu, float invH, bool explicitMode) {
+  const Sweep w(c, s0, s1, margin);
+  gatherCandidates<S>(c, p, q, w);
+  for (const std::uint32_t i : *q.candidates) {
+    const Vec3 x(p.px[i], p.py[i], p.pz[i]);
+    const Vec3 x0(p.sx[i], p.sy[i], p.sz[i]);
+    const Vec3 rel = x - w.B.position;
+    const float travel = (x - x0).norm();
+    float sweep = travel + w.shift;
+    if constexpr (S != ColliderShape::Plane) {
+      // How far the particle moves relative to the collider's frame, at most: its own travel plus the
+      // collider's translation and its rotation at this distance from the origin.
+      const float relNorm = rel.norm();
+      sweep += w.turn * (relNorm + travel);
+      if (relNorm > w.bound + margin + sweep) continue;  // cannot touch in this substep
+    }
+    const Vec3 b = w.invRB * rel;
+    // The signed distance is 1-Lipschitz: if the end is farther than the whole relative motion, the segment
+    // never came within the margin.
+    if (shapeDistanceOnly<S>(c, b) >= margin + sweep) continue;
+    const SurfaceDistance sb = shapeDistance<S>(c, b);
+    const Vec3 a = w.invRA * (x0 - w.A.position);
+    Vec3 bn, normal;
+    if (!resolveSweep<S>(c, margin, a, b, sb, bn, normal)) continue;
+    applyFriction(mu, a, b, normal, bn);
+    const Vec3 xn = w.RB * bn + w.B.position;
+    if (explicitMode) {
+      // The seed moves positions only; keep the velocity consistent with the correction.
+      p.vx[i] += (xn.x() - x.x()) * invH;
+      p.vy[i] += (xn.y() - x.y()) * invH;
+      p.vz[i] += (xn.z() - x.z()) * invH;
+    }
+    p.px[i] = xn.x();
+    p.py[i] = xn.y();
+    p.pz[i] = xn.z();
+    q.contacts->push_back({i, q.collider});
+  }
+}
+
+/// Pushes the contact's particle back out of its collider (pose at the substep's end) if the constraint
+/// solve moved it into the skin.
+template <ColliderShape S>
+void reprojectOne(const Collider& c, const Pose& B, float margin, float* px, float* py, float* pz, std::uint32_t i) {
+  const Vec3 x(px[i], py[i], pz[i]);
+  const Vec3 b = B.applyInverse(x);
+  const SurfaceDistance s = shapeDistance<S>(c, b);
+  if (s.distance >= margin) return;
+  const Vec3 xn = B.apply(b + (margin - s.distance) * s.normal);
+  px[i] = xn.x();
+  py[i] = xn.y();
+  pz[i] = xn.z();
+}
+
+}  // namespace
+
+BodyCollision::BodyCollision(std::size_t particles) {
+  colliderEnd_.reserve(64);
+  contacts_.reserve(4 * particles);
+  distance2_.resize(static_cast<Eigen::Index>(particles));
+  candidates_.reserve(particles);
+}
+
+void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settings, float h, float s0, float s1,
+                            ColliderSpan colliders, bool explicitMode) {
+  PassArrays q{&contacts_, 0, 0.0f, &distance2_, &candidates_};
+  float maxTravel2 = 0.0f;
+  for (Eigen::Index i = 0; i < p.n; ++i) {
+    const float dx = p.px[i] - p.sx[i], dy = p.py[i] - p.sy[i], dz = p.pz[i] - p.sz[i];
+    maxTravel2 = std::max(maxTravel2, dx * dx + dy * dy + dz * dz);
+  }
+  q.maxTravel = std::sqrt(maxTravel2);
+  const float invH = 1.0f / h;
+  contacts_.clear();
+  colliderEnd_.clear();
+  for (const Collider& c : colliders) {
+    colliderEnd_.push_back(Pose::interpolate(c.previous, c.current, s1));
+    q.collider = static_cast<std::uint32_t>(colliderEnd_.size() - 1);
+    if (!c.validate().ok()) continue;  // documented: an invalid collider (NaN pose, bad size) is skipped
+    const float margin = settings.collisionThickness + c.thickness;
+    const float mu = c.friction >= 0.0f ? c.friction : settings.friction;
+    switch (c.shape) {
+      case ColliderShape::Sphere: collideWith<ColliderShape::Sphere>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::Capsule: collideWith<ColliderShape::Capsule>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::Cylinder: collideWith<ColliderShape::Cylinder>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::Box: collideWith<ColliderShape::Box>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::Plane: collideWith<ColliderShape::Plane>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
+    }
+  }
+}
+
+void BodyCollision::reproject(const CollisionArrays& p, const CapeSettings& settings, ColliderSpan colliders) {
+  for (const Cape::Contact& k : contacts_) {
+    const Collider& c = colliders.data[k.collider];
+    const Pose& B = colliderEnd_[k.collider];
+    const float margin = settings.collisionThickness + c.thickness;
+    switch (c.shape) {
+      case ColliderShape::Sphere: reprojectOne<ColliderShape::Sphere>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
+      case ColliderShape::Capsule: reprojectOne<ColliderShape::Capsule>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
+      case ColliderShape::Cylinder: reprojectOne<ColliderShape::Cylinder>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
+      case ColliderShape::Box: reprojectOne<ColliderShape::Box>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
+      case ColliderShape::Plane: reprojectOne<ColliderShape::Plane>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
+    }
+  }
+}
+
+}  // namespace cape::detail

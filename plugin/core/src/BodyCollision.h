@@ -1,0 +1,50 @@
+// BodyCollision: the body-collision stage of a substep and its scratch memory. Every free particle is tested
+// against every collider's sweep over the substep (its pose interpolated from the step's start to its end),
+// pushed out to the collider's surface plus the thicknesses, with the collider's Coulomb friction; the
+// contacts are kept for the reprojection passes after the constraint solve.
+#pragma once
+
+#include "cape/core/Cape.h"
+
+#include <vector>
+
+namespace cape::detail {
+
+/// The particle arrays a collision pass reads and writes (columns of CapeState and the substep's start).
+struct CollisionArrays {
+  float* px;
+  float* py;
+  float* pz;
+  const float* sx;  ///< positions at the start of the substep
+  const float* sy;
+  const float* sz;
+  const float* w;   ///< inverse masses (0: pinned, never moved)
+  float* vx;        ///< velocities, corrected only in the explicit mode
+  float* vy;
+  float* vz;
+  Eigen::Index n;
+};
+
+class BodyCollision {
+ public:
+  explicit BodyCollision(std::size_t particles);
+
+  /// The substep [s0, s1] of the step (fractions of it; h seconds long): every free particle of `p` against
+  /// every valid collider's sweep. An invalid collider (NaN pose, bad size) is skipped. In the explicit
+  /// mode the velocities follow the position corrections.
+  void collide(const CollisionArrays& p, const CapeSettings& settings, float h, float s0, float s1,
+               ColliderSpan colliders, bool explicitMode);
+  /// Pushes each contact's particle back out of its collider (at its pose at the substep's end) if the
+  /// passes since collide() moved it into the skin.
+  void reproject(const CollisionArrays& p, const CapeSettings& settings, ColliderSpan colliders);
+  /// Contacts of the last collide(): particle and index into its colliders.
+  const std::vector<Cape::Contact>& contacts() const { return contacts_; }
+
+ private:
+  std::vector<Pose> colliderEnd_;          ///< Collider poses at the end of the substep.
+  std::vector<Cape::Contact> contacts_;    ///< Contacts of the substep's collision pass.
+  Eigen::ArrayXf distance2_;               ///< Broad-phase scratch, one per particle.
+  std::vector<std::uint32_t> candidates_;  ///< Broad-phase scratch.
+};
+
+}  // namespace cape::detail

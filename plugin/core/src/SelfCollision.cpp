@@ -1,0 +1,482 @@
+// Self-collision: predictive particle-triangle contacts (Lewin 2018, "Cloth Self Collision with Predictive
+// Contacts", GDC). At the start of a step (and every few substeps while the cape moves fast) every particle
+// that could come within the thickness of a triangle it does not belong to before the next search is paired
+// with it, and the side of the triangle it is on is noted. The substeps then keep the particle on that side,
+// at least the thickness away: as long as the cape starts free of intersections, no particle can pass
+// through a triangle, however fast the fold.
+#include "SelfCollision.h"
+
+#include "cape/core/Geometry.h"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+// The per-pair test is called from three loops; inlined, the search runs a few percent faster (measured).
+#if defined(__GNUC__)
+#define CAPE_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define CAPE_ALWAYS_INLINE
+#endif
+
+namespace cape::detail {
+
+namespace {
+
+/// Barycentric weights of p's projection onto the plane of (a, b, c), unclamped; false if degenerate.
+bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float& wa, float& wb, float& wc) {
+  const Vec3 v0 = b - a, v1 = c - a, v2 = p - a;
+  const float d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
+  const float den = d00 * d11 - d01 * d01;
+  if (!(den > 1e-20f)) return false;
+  wb = (d11 * d20 - d01 * d21) / den;
+  wc = (d00 * d21 - d01 * d20) / den;
+  wa = 1.0f - wb - wc;
+  return true;
+}
+
+/// A particle over a triangle grown by this fraction of itself (in barycentric terms) keeps its side: the
+/// grown triangles of a vertex's ring overlap, so a particle heading straight for a vertex or an edge of the
+/// other layer (two halves of a folded grid line up exactly) is caught as surely as one heading for a face.
+constexpr float kFaceMargin = 0.25f;
+
+inline bool overFace(float wa, float wb, float wc) { return wa >= -kFaceMargin && wb >= -kFaceMargin && wc >= -kFaceMargin; }
+
+inline Vec3 at(const Points& x, std::uint32_t i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
+
+// A hash entry keeps its cluster's index in the unused fourth lane of the box's low corner, as the bits of
+// a float that every comparison below passes (fewer than 2^25 clusters: a positive finite float).
+inline float indexBits(std::uint32_t i) {
+  float f;
+  std::memcpy(&f, &i, sizeof f);
+  return f;
+}
+inline std::uint32_t bitsIndex(float f) {
+  std::uint32_t i;
+  std::memcpy(&i, &f, sizeof i);
+  return i;
+}
+
+inline std::uint32_t bucketOf(int ix, int iy, int iz, std::uint32_t mask) {
+  const std::uint32_t h = static_cast<std::uint32_t>(ix) * 73856093u ^ static_cast<std::uint32_t>(iy) * 19349663u ^
+                          static_cast<std::uint32_t>(iz) * 83492791u;
+  return h & mask;
+}
+
+// A box spanning more cells than this per axis (a fast or huge motion) is not binned: such triangles go on
+// a list every particle checks, and such a particle checks every triangle. Bounded work, whatever the motion.
+constexpr int kMaxSpan = 6;
+
+/// The cells of a box: [c[0], c[4]] x [c[1], c[5]] x [c[2], c[6]] (c holds 8); false if it spans too many to
+/// bin. floor() is a library call in a portable (pre-SSE4.1) build: truncate and correct instead.
+inline bool cellsOf(float invCell, float lx, float ly, float lz, float hx, float hy, float hz, int* c) {
+#if defined(__SSE2__)
+  const __m128 scale = _mm_set1_ps(invCell);
+  const auto floorCells = [scale](__m128 v, int* out) {
+    const __m128 f = _mm_mul_ps(v, scale);
+    const __m128i i = _mm_cvttps_epi32(f);
+    // All ones (-1) where truncation went up, i.e. below zero.
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_add_epi32(i, _mm_castps_si128(_mm_cmplt_ps(f, _mm_cvtepi32_ps(i)))));
+  };
+  floorCells(_mm_setr_ps(lx, ly, lz, lz), c);
+  floorCells(_mm_setr_ps(hx, hy, hz, hz), c + 4);
+#else
+  const float v[6] = {lx, ly, lz, hx, hy, hz};
+  for (int k = 0; k < 6; ++k) {
+    const float f = v[k] * invCell;
+    const int i = static_cast<int>(f);
+    c[k < 3 ? k : k + 1] = i - (f < static_cast<float>(i) ? 1 : 0);
+  }
+#endif
+  return c[4] - c[0] <= kMaxSpan && c[5] - c[1] <= kMaxSpan && c[6] - c[2] <= kMaxSpan;
+}
+
+/// Whether particle q is local to a triangle (its corners and the far corners across its edges): it reaches
+/// such a triangle only by folding that edge's hinge flat, which the spring between the two far corners (a
+/// shear or bend spring) resists, and the two triangles share an edge, so the hinge cannot make a
+/// self-intersecting pair. At rest the other half of a grid cell is 0.71 spacings away, within the search's
+/// reach: these were most of the exact tests.
+inline bool isLocal(const TriangleLocalSet& set, std::uint32_t q) {
+  const std::uint32_t* v = set.v;
+#if defined(__SSE2__)
+  const __m128i key = _mm_set1_epi32(static_cast<int>(q));
+  const __m128i lo = _mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(v)), key);
+  const __m128i hi = _mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(v + 4)), key);
+  return _mm_movemask_epi8(_mm_or_si128(lo, hi)) != 0;
+#else
+  return (q == v[0]) | (q == v[1]) | (q == v[2]) | (q == v[3]) | (q == v[4]) | (q == v[5]);
+#endif
+}
+
+inline bool boxesOverlap(const float* qlo, const float* qhi, const float* lo, const float* hi) {
+  return (qhi[0] >= lo[0]) & (qhi[1] >= lo[1]) & (qhi[2] >= lo[2]) & (qlo[0] <= hi[0]) & (qlo[1] <= hi[1]) &
+         (qlo[2] <= hi[2]);
+}
+
+}  // namespace
+
+
+SelfCollision::SelfCollision(const Fabric& fabric) : fabric_(fabric) {
+  const std::size_t n = fabric.particleCount(), triangles = fabric.triangleCount();
+  // A hash of at least twice as many buckets as particles (a power of two).
+  std::uint32_t buckets = 1;
+  while (buckets < 2 * static_cast<std::uint32_t>(n)) buckets <<= 1;
+  hashStart_.assign(buckets + 1, 0u);
+  bucketCluster_.assign(buckets, ~0u);
+  hashEntries_.assign(8 * triangles, HashEntry{});
+  bucketHits_.assign(hashEntries_.size(), 0u);
+  triangleMotion_.assign(triangles, 0.0f);
+  triangleStamp_.assign(triangles, 0u);
+  largeTriangles_.reserve(triangles);
+  clusterBuckets_.reserve(8 * triangles);
+  clusterBoxes_.assign(6 * fabric.clusterCount(), 0.0f);
+  clusterBucketStart_.assign(fabric.clusterCount() + 1, 0u);
+  stepMotion_ = Points::Zero(static_cast<Eigen::Index>(n), 3);
+  stepMotionNorm_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(n));
+  contacts_.reserve(32 * n);
+}
+
+float SelfCollision::thickness(const CapeSettings& settings) const {
+  // As set, or 0.35 of the mean spacing (CapeSettings::selfCollisionThickness explains the choice).
+  constexpr float kAutoThickness = 0.35f;
+  return settings.selfCollisionThickness > 0.0f ? settings.selfCollisionThickness
+                                                : kAutoThickness * fabric_.meanSpacing();
+}
+
+int SelfCollision::schedule(const CapeState& state, const Eigen::VectorXf& freeMask, const CapeSettings& settings,
+                            float dt, int substeps) {
+  // Self-contacts are found from where the cape is now and kept through the substeps. One search covers at
+  // most a spacing of motion (relative to the cape's rigid motion) and at most one settings.timeStep. A
+  // calm cape (no particle faster than a spacing per timeStep) searches once per timeStep: a world stepping
+  // at 1/240 s then searches once per 1/60 s, with that 1/60 s's motion bound. A faster one searches again
+  // every few substeps: a search over a whole fast frame would pair every particle with every triangle it
+  // might sweep past, and the substeps would carry thousands of contacts.
+  if (!(state.time + static_cast<double>(dt) > validUntil_ + 1e-9)) return 0;  // still covered
+  const float spacing = fabric_.meanSpacing();
+  // The fastest particle relative to the cape's rigid motion (predictMotion), m/s.
+  const float fastest = predictMotion(state, freeMask, settings.gravity, dt) / dt;
+  constexpr float kSearchMotion = 1.0f;  // spacings of motion one search may cover
+  if (std::isfinite(fastest) && fastest * settings.timeStep < kSearchMotion * spacing) {
+    const float window = std::max(dt, settings.timeStep);
+    if (window != dt) predictMotion(state, freeMask, settings.gravity, window);
+    find(state.positions, state.velocities, thickness(settings));
+    ++searches_;
+    validUntil_ = state.time + static_cast<double>(window);
+    return 0;
+  }
+  // Enough searches that none covers more than kSearchMotion spacings; every substep at most (and for a
+  // non-finite motion, whose search finds nothing: find() leaves a blown-up cape alone).
+  const float wanted = fastest * dt / (kSearchMotion * spacing);
+  const int searches = std::isfinite(wanted) ? static_cast<int>(std::clamp(std::ceil(wanted), 1.0f, static_cast<float>(substeps))) : substeps;
+  validUntil_ = state.time + static_cast<double>(dt);
+  return (substeps + searches - 1) / searches;
+}
+
+void SelfCollision::searchFor(const CapeState& state, const Eigen::VectorXf& freeMask, const CapeSettings& settings,
+                              float window) {
+  predictMotion(state, freeMask, settings.gravity, window);
+  find(state.positions, state.velocities, thickness(settings));
+  ++searches_;
+}
+
+float SelfCollision::predictMotion(const CapeState& state, const Eigen::VectorXf& freeMask, const Vec3& gravity, float dt) {
+  // How far each particle may move in dt, v dt + g dt^2 / 2 (pinned particles move at the velocity their
+  // pin gave them), less a rigid motion of the whole cape: a rigid motion changes no distance, so only what
+  // is left can bring a particle closer to a triangle. The rigid motion is the least-squares fit of a
+  // translation and a small rotation (the mean displacement, and theta from I theta = sum r x m with I the
+  // points' inertia about their centroid), applied exactly. Walking carries every particle 2 cm per frame
+  // and a sprinter's turn swings the whole cape round: neither brings two of its particles together.
+  const Points& x = state.positions;
+  const Eigen::Index n = x.rows();
+  stepMotion_ = state.velocities * dt;
+  for (int c = 0; c < 3; ++c) stepMotion_.col(c) += (0.5f * dt * dt * gravity[c]) * freeMask;
+  const Vec3 translation = stepMotion_.colwise().mean().transpose();
+  const Vec3 centroid = x.colwise().mean().transpose();
+  // Plain loops over the columns: this runs before every search.
+  const float *px = x.col(0).data(), *py = x.col(1).data(), *pz = x.col(2).data();
+  float *mx = stepMotion_.col(0).data(), *my = stepMotion_.col(1).data(), *mz = stepMotion_.col(2).data();
+  float sxx = 0, syy = 0, szz = 0, sxy = 0, sxz = 0, syz = 0;
+  Vec3 moment = Vec3::Zero();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const float rx = px[i] - centroid.x(), ry = py[i] - centroid.y(), rz = pz[i] - centroid.z();
+    const float ux = mx[i] - translation.x(), uy = my[i] - translation.y(), uz = mz[i] - translation.z();
+    sxx += rx * rx;
+    syy += ry * ry;
+    szz += rz * rz;
+    sxy += rx * ry;
+    sxz += rx * rz;
+    syz += ry * rz;
+    moment += Vec3(ry * uz - rz * uy, rz * ux - rx * uz, rx * uy - ry * ux);
+  }
+  Eigen::Matrix3f inertia;
+  inertia << syy + szz, -sxy, -sxz, -sxy, sxx + szz, -syz, -sxz, -syz, sxx + syy;
+  Eigen::Matrix3f rotationMinusIdentity = Eigen::Matrix3f::Zero();
+  const Eigen::LDLT<Eigen::Matrix3f> ldlt(inertia);
+  if (ldlt.info() == Eigen::Success && ldlt.isPositive() && inertia.trace() > 0.0f) {
+    const Vec3 theta = ldlt.solve(moment);
+    const float angle = theta.norm();
+    // Any rigid motion keeps the bound exact; a poor fit (or none) only makes it looser.
+    if (std::isfinite(angle) && angle > 0.0f && angle < 1.0f)
+      rotationMinusIdentity = Eigen::AngleAxisf(angle, theta / angle).toRotationMatrix() - Eigen::Matrix3f::Identity();
+  }
+  const Eigen::Matrix3f& k = rotationMinusIdentity;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const float rx = px[i] - centroid.x(), ry = py[i] - centroid.y(), rz = pz[i] - centroid.z();
+    mx[i] -= translation.x() + k(0, 0) * rx + k(0, 1) * ry + k(0, 2) * rz;
+    my[i] -= translation.y() + k(1, 0) * rx + k(1, 1) * ry + k(1, 2) * rz;
+    mz[i] -= translation.z() + k(2, 0) * rx + k(2, 1) * ry + k(2, 2) * rz;
+  }
+  stepMotionNorm_ = stepMotion_.rowwise().norm();  // same size every step: no allocation
+  return stepMotionNorm_.maxCoeff();
+}
+
+void SelfCollision::grownBox(std::uint32_t t, Vec3& lo, Vec3& hi) const {
+  // A triangle's box grown by the thickness, the slack and its motion (as binned, and for the rare unbinned
+  // paths).
+  const std::vector<std::uint32_t>& tri = fabric_.triangles();
+  const Points& x = *x_;
+  const Vec3 a = at(x, tri[3 * t]), b = at(x, tri[3 * t + 1]), c = at(x, tri[3 * t + 2]);
+  const float grow = thickness_ + slack_ + triangleMotion_[t];
+  lo = a.cwiseMin(b).cwiseMin(c).array() - grow;
+  hi = a.cwiseMax(b).cwiseMax(c).array() + grow;
+}
+
+CAPE_ALWAYS_INLINE inline void SelfCollision::consider(std::uint32_t q, const Vec3& p, std::uint32_t t, bool stamp) {
+  // One particle against one triangle whose grown box its motion's box overlaps: the exact filter, and the
+  // contact with the side it is on.
+  if (isLocal(fabric_.triangleLocal()[t], q)) return;
+  if (stamp) {
+    if (triangleStamp_[t] == q) return;  // met already through another cell
+    triangleStamp_[t] = q;
+  }
+  // The bounding sphere first (about the centroid, out to the farthest corner), with the two motions
+  // added: it rejects most of what overlapping boxes let through. Computed here, not when binning: most
+  // triangles meet no particle but their own corners, which the scan passes over.
+  const std::vector<std::uint32_t>& tri = fabric_.triangles();
+  const Points& x = *x_;
+  const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
+  const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
+  const Vec3 centroid = (a + b + c) / 3.0f;
+  const float radius = std::sqrt(std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()}));
+  const float d2 = (p - centroid).squaredNorm();
+  const float loose = thickness_ + slack_ + stepMotionNorm_[q] + triangleMotion_[t] + radius;
+  if (d2 > loose * loose) return;
+  // How much closer the two may come: the particle's motion relative to the triangle's corners.
+  const Vec3 mqv = stepMotion_.row(q).transpose();
+  const float closing = std::sqrt(std::max({(mqv - stepMotion_.row(ia).transpose()).squaredNorm(),
+                                            (mqv - stepMotion_.row(ib).transpose()).squaredNorm(),
+                                            (mqv - stepMotion_.row(ic).transpose()).squaredNorm()}));
+  const float within = thickness_ + slack_ + closing;
+  // The sphere again with the relative motion, then the triangle itself.
+  const float reach = within + radius;
+  if (d2 > reach * reach) return;
+  const TriangleNearest w = nearestOnTriangle(p, a, b, c);
+  const Vec3 nearest = w.wa * a + w.wb * b + w.wc * c;
+  if ((p - nearest).squaredNorm() > within * within) return;
+  float side = 0.0f, wa, wb, wc;
+  if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc))
+    side = (b - a).cross(c - a).dot(p - a) >= 0.0f ? 1.0f : -1.0f;
+  contacts_.push_back({q, t, side});
+}
+
+void SelfCollision::find(const Points& x, const Points& v, float thickness) {
+  contacts_.clear();
+  // A cape that is no longer finite has blown up (the metrics report it); there is nothing to keep apart.
+  if (!x.allFinite() || !v.allFinite()) return;
+  // A pair can close in by at most their relative motion; the solver's own corrections (springs, collisions)
+  // add some more, which a quarter of the spacing allows for. Cells twice the spacing: a triangle spans one
+  // or two per axis.
+  x_ = &x;
+  thickness_ = thickness;
+  slack_ = 0.25f * fabric_.meanSpacing();
+  invCell_ = 1.0f / (2.0f * fabric_.meanSpacing());
+  mask_ = static_cast<std::uint32_t>(hashStart_.size() - 1) - 1;
+  bin();
+  // Each particle visits the cells of its own motion's box.
+  std::fill(triangleStamp_.begin(), triangleStamp_.end(), ~0u);
+  const std::size_t triangles = fabric_.triangleCount();
+  for (Eigen::Index qi = 0; qi < x.rows(); ++qi) {
+    const std::uint32_t q = static_cast<std::uint32_t>(qi);
+    const Vec3 p = at(x, q);
+    const float mq = stepMotionNorm_[qi];
+    const float qlo[3] = {p.x() - mq, p.y() - mq, p.z() - mq}, qhi[3] = {p.x() + mq, p.y() + mq, p.z() + mq};
+    int range[8];
+    if (!cellsOf(invCell_, qlo[0], qlo[1], qlo[2], qhi[0], qhi[1], qhi[2], range)) {
+      for (std::size_t t = 0; t < triangles; ++t) {
+        Vec3 tlo, thi;
+        grownBox(static_cast<std::uint32_t>(t), tlo, thi);
+        if (boxesOverlap(qlo, qhi, tlo.data(), thi.data())) consider(q, p, static_cast<std::uint32_t>(t), false);
+      }
+      continue;
+    }
+    // Only a particle whose box spans several cells can meet a triangle twice.
+    const bool stamp = range[4] > range[0] || range[5] > range[1] || range[6] > range[2];
+    for (int ix = range[0]; ix <= range[4]; ++ix)
+      for (int iy = range[1]; iy <= range[5]; ++iy)
+        for (int iz = range[2]; iz <= range[6]; ++iz) scanBucket(q, p, qlo, qhi, bucketOf(ix, iy, iz, mask_), stamp);
+    for (const std::uint32_t t : largeTriangles_) {
+      Vec3 tlo, thi;
+      grownBox(t, tlo, thi);
+      if (boxesOverlap(qlo, qhi, tlo.data(), thi.data())) consider(q, p, t, false);
+    }
+  }
+}
+
+void SelfCollision::bin() {
+  // Bin the triangles, each grown by the thickness, the slack and its own motion, into the cells of a hashed
+  // grid. Binned by cluster (the two triangles of a grid cell share its box): half the entries of binning each.
+  const std::vector<std::uint32_t>& tri = fabric_.triangles();
+  const std::vector<std::uint32_t>& clusterStart = fabric_.clusterStart();
+  const std::uint32_t buckets = static_cast<std::uint32_t>(hashStart_.size() - 1);
+  largeTriangles_.clear();
+  clusterBuckets_.clear();
+  std::fill(hashStart_.begin(), hashStart_.end(), 0u);
+  std::fill(bucketCluster_.begin(), bucketCluster_.end(), ~0u);
+  const std::size_t clusters = fabric_.clusterCount();
+  for (std::size_t g = 0; g < clusters; ++g) {
+    clusterBucketStart_[g] = static_cast<std::uint32_t>(clusterBuckets_.size());
+    Vec3 lo = Vec3::Constant(std::numeric_limits<float>::max()), hi = -lo;
+    for (std::uint32_t t = clusterStart[g]; t < clusterStart[g + 1]; ++t) {
+      triangleMotion_[t] = std::max({stepMotionNorm_[tri[3 * t]], stepMotionNorm_[tri[3 * t + 1]], stepMotionNorm_[tri[3 * t + 2]]});
+      Vec3 tlo, thi;
+      grownBox(t, tlo, thi);
+      lo = lo.cwiseMin(tlo);
+      hi = hi.cwiseMax(thi);
+    }
+    float* clusterBox = &clusterBoxes_[6 * g];
+    for (int k = 0; k < 3; ++k) {
+      clusterBox[k] = lo[k];
+      clusterBox[3 + k] = hi[k];
+    }
+    int range[8];
+    if (!cellsOf(invCell_, lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z(), range)) {
+      for (std::uint32_t t = clusterStart[g]; t < clusterStart[g + 1]; ++t) largeTriangles_.push_back(t);
+      continue;
+    }
+    // The buckets of its cells, kept for the fill below (at most (kMaxSpan + 1)^3; usually 1 to 8).
+    for (int ix = range[0]; ix <= range[4]; ++ix)
+      for (int iy = range[1]; iy <= range[5]; ++iy)
+        for (int iz = range[2]; iz <= range[6]; ++iz) {
+          const std::uint32_t bucket = bucketOf(ix, iy, iz, mask_);
+          // Once per bucket, even if two of its cells hash to the same one: a particle that visits a single
+          // cell then meets each triangle at most once, and needs no stamps.
+          if (bucketCluster_[bucket] == g) continue;
+          bucketCluster_[bucket] = static_cast<std::uint32_t>(g);
+          ++hashStart_[bucket + 1];
+          clusterBuckets_.push_back(bucket);  // grows rarely: capacity kept between steps
+        }
+  }
+  clusterBucketStart_[clusters] = static_cast<std::uint32_t>(clusterBuckets_.size());
+  for (std::uint32_t b = 0; b < buckets; ++b) hashStart_[b + 1] += hashStart_[b];  // [b] = start of bucket b
+  if (hashEntries_.size() < hashStart_[buckets]) {  // grows rarely
+    hashEntries_.resize(hashStart_[buckets]);
+    bucketHits_.resize(hashStart_[buckets]);
+  }
+  // Fill in cluster order (deterministic), each bucket's start serving as its cursor...
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (std::size_t g = 0; g < clusters; ++g) {
+    const float* box = &clusterBoxes_[6 * g];
+    const HashEntry entry{{box[0], box[1], box[2], indexBits(static_cast<std::uint32_t>(g))}, {box[3], box[4], box[5], kInf}};
+    for (std::uint32_t k = clusterBucketStart_[g]; k < clusterBucketStart_[g + 1]; ++k)
+      hashEntries_[hashStart_[clusterBuckets_[k]]++] = entry;
+  }
+  // ...which leaves [b] at the end of bucket b: shift back so bucket b is [hashStart_[b], hashStart_[b + 1]).
+  for (std::uint32_t b = buckets; b > 0; --b) hashStart_[b] = hashStart_[b - 1];
+  hashStart_[0] = 0;
+}
+
+void SelfCollision::scanBucket(std::uint32_t q, const Vec3& p, const float* qlo, const float* qhi,
+                               std::uint32_t bucket, bool stamp) {
+  // The bucket's overlapping entries first, without a branch per entry (about one in four overlaps: too many
+  // for branches to predict), then the exact tests. The clusters the particle is a corner of overlap it but
+  // hold nothing for it (95 % of what overlaps, on a walking cape): one compare passes each over.
+  const HashEntry* entry = hashEntries_.data() + hashStart_[bucket];
+  const std::uint32_t count = hashStart_[bucket + 1] - hashStart_[bucket];
+  std::uint32_t* found = bucketHits_.data();
+  std::uint32_t hits = 0;
+#if defined(__SSE2__)
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const __m128 queryLo = _mm_setr_ps(qlo[0], qlo[1], qlo[2], -kInf), queryHi = _mm_setr_ps(qhi[0], qhi[1], qhi[2], kInf);
+  const __m128i self = _mm_set1_epi32(static_cast<int>(q));
+#endif
+  for (std::uint32_t e = 0; e < count; ++e) {
+    found[hits] = e;
+#if defined(__SSE2__)
+    const __m128 inside = _mm_and_ps(_mm_cmpge_ps(queryHi, _mm_load_ps(entry[e].lo)), _mm_cmple_ps(queryLo, _mm_load_ps(entry[e].hi)));
+    hits += _mm_movemask_ps(inside) == 0xF ? 1u : 0u;
+#else
+    hits += boxesOverlap(qlo, qhi, entry[e].lo, entry[e].hi) ? 1u : 0u;
+#endif
+  }
+  const std::vector<std::uint32_t>& clusterStart = fabric_.clusterStart();
+  for (std::uint32_t k = 0; k < hits; ++k) {
+    const std::uint32_t g = bitsIndex(entry[found[k]].lo[3]);
+    const std::uint32_t* l = fabric_.clusterLocal()[g].v;
+#if defined(__SSE2__)
+    if (_mm_movemask_epi8(_mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(l)), self)) != 0) continue;
+#else
+    if ((q == l[0]) | (q == l[1]) | (q == l[2]) | (q == l[3])) continue;
+#endif
+    for (std::uint32_t t = clusterStart[g]; t < clusterStart[g + 1]; ++t) consider(q, p, t, stamp);
+  }
+}
+
+void SelfCollision::solve(Points& x, const float* w, float thickness) {
+  // The deepest a particle can have crossed within one step and still be brought back: half the spacing.
+  const float maxCrossing = 0.5f * fabric_.meanSpacing();
+  const std::vector<std::uint32_t>& tri = fabric_.triangles();
+  for (Cape::SelfContact& k : contacts_) {
+    const std::uint32_t ia = tri[3 * k.triangle], ib = tri[3 * k.triangle + 1], ic = tri[3 * k.triangle + 2];
+    const Vec3 p = at(x, k.particle), a = at(x, ia), b = at(x, ib), c = at(x, ic);
+    if (k.side != 0.0f) {
+      // Most listed pairs are apart: on their side of the plane and at least the thickness from it, so
+      // farther than that from the triangle too. Rejected here without the nearest point.
+      const Vec3 n = (b - a).cross(c - a);
+      const float d = k.side * n.dot(p - a);
+      if (d >= 0.0f && d * d >= thickness * thickness * n.squaredNorm()) continue;
+    }
+    const TriangleNearest bary = nearestOnTriangle(p, a, b, c);
+    Vec3 normal;
+    float distance;
+    float wa, wb, wc;
+    if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc)) {
+      // Over the (grown) face: keep to the side the particle started the step on, or first came over it from.
+      Vec3 faceNormal = (b - a).cross(c - a);
+      const float len = faceNormal.norm();
+      if (!(len > 0.0f)) continue;
+      faceNormal /= len;
+      if (k.side == 0.0f) k.side = faceNormal.dot(p - a) >= 0.0f ? 1.0f : -1.0f;
+      normal = k.side * faceNormal;
+      distance = normal.dot(p - a);  // negative: it has crossed, and is brought back
+      // Far on the other side is not a crossing within this step (the region over a face reaches out along
+      // its normal without end, and a triangle that turns over carries its side with it): pulling such a
+      // particle back through the cloth would throw it across the cape, so the pair is let go.
+      if (distance < -maxCrossing) continue;
+      // The correction goes to the corners by the weights of the nearest point of the real triangle.
+    } else {
+      // Beside an edge or a corner: a plain distance, no side to keep.
+      const Vec3 d = p - (bary.wa * a + bary.wb * b + bary.wc * c);
+      distance = d.norm();
+      if (!(distance > 1e-9f)) continue;
+      normal = d / distance;
+    }
+    if (distance >= thickness) continue;
+    // PBD point-triangle constraint C = n . (p - sum w_k x_k) - thickness >= 0, gradients n and -w_k n.
+    const float invP = w[k.particle], invA = w[ia], invB = w[ib], invC = w[ic];
+    const float denominator = invP + bary.wa * bary.wa * invA + bary.wb * bary.wb * invB + bary.wc * bary.wc * invC;
+    if (!(denominator > 0.0f)) continue;
+    const Vec3 step = ((thickness - distance) / denominator) * normal;
+    x.row(k.particle) += invP * step.transpose();
+    x.row(ia) -= (invA * bary.wa) * step.transpose();
+    x.row(ib) -= (invB * bary.wb) * step.transpose();
+    x.row(ic) -= (invC * bary.wc) * step.transpose();
+  }
+}
+
+}  // namespace cape::detail
