@@ -17,7 +17,9 @@ float boundingRadius(const Collider& c) {
     case ColliderShape::Capsule: return c.radius + c.halfHeight;
     case ColliderShape::Cylinder: return std::hypot(c.radius, c.halfHeight);
     case ColliderShape::Box: return c.halfExtents.norm();
-    case ColliderShape::Plane: return std::numeric_limits<float>::infinity();
+    case ColliderShape::ConvexHull: return c.hull->radius;
+    case ColliderShape::Plane:
+    case ColliderShape::TriangleMesh: return std::numeric_limits<float>::infinity();
   }
   return std::numeric_limits<float>::infinity();
 }
@@ -25,6 +27,7 @@ float boundingRadius(const Collider& c) {
 /// What one collider's pass needs besides the particles.
 struct PassArrays {
   std::vector<Cape::Contact>* contacts;
+  std::vector<Eigen::Vector4f>* planes;    ///< per contact: a triangle mesh's contact plane (n, offset)
   std::uint32_t collider;
   float maxTravel;                         ///< the largest distance any particle moved in this substep, m
   Eigen::ArrayXf* distance2;               ///< scratch, one per particle
@@ -75,7 +78,8 @@ void gatherCandidates(const Collider& c, const CollisionArrays& p, const PassArr
     const float m20 = M(2, 0), m21 = M(2, 1), m22 = M(2, 2);
     const float ox = w.B.position.x(), oy = w.B.position.y(), oz = w.B.position.z();
     const float hx = c.halfExtents.x(), hy = c.halfExtents.y(), hz = c.halfExtents.z();
-    const float radius = c.radius, halfHeight = c.halfHeight, turn = w.turn;
+    const float radius = S == ColliderShape::ConvexHull ? c.hull->radius : c.radius;
+    const float halfHeight = c.halfHeight, turn = w.turn;
     const float fixedReach = w.margin + w.shift + q.maxTravel * (1.0f + turn) + kSlack;
     const float* __restrict px = p.px;
     const float* __restrict py = p.py;
@@ -85,8 +89,8 @@ void gatherCandidates(const Collider& c, const CollisionArrays& p, const PassArr
       const float rx = px[i] - ox, ry = py[i] - oy, rz = pz[i] - oz;
       const float relNorm = std::sqrt(rx * rx + ry * ry + rz * rz);
       float lower;
-      if constexpr (S == ColliderShape::Sphere) {
-        lower = relNorm - radius;
+      if constexpr (S == ColliderShape::Sphere || S == ColliderShape::ConvexHull) {
+        lower = relNorm - radius;  // a hull's bounding sphere
       } else {
         const float b0 = m00 * rx + m01 * ry + m02 * rz;
         const float b1 = m10 * rx + m11 * ry + m12 * rz;
@@ -220,7 +224,56 @@ __attribute__((flatten)) void collideWith(const Collider& c, const CollisionArra
     p.py[i] = xn.y();
     p.pz[i] = xn.z();
     q.contacts->push_back({i, q.collider});
+    q.planes->push_back(Eigen::Vector4f::Zero());
   }
+}
+
+/// One particle of a triangle mesh's pass, in the mesh's frame: at b (its prediction), against its candidate
+/// triangles, each on the side of its plane the particle was on at the start of the step. Returns whether
+/// it touched; then bn is where it ends and `plane` the last contact plane (n, offset).
+inline bool resolveMesh(const TriangleSoup& soup, const MeshCandidate* begin, const MeshCandidate* end, float margin,
+                        const Vec3& b, Vec3& bn, Vec3& normal, Eigen::Vector4f& plane) {
+  // Over a face by barycentric weights of the projection with this tolerance: a point over the edge two
+  // triangles share is over both, never beside both.
+  constexpr float kOverFace = 1e-4f;
+  bn = b;
+  bool touched = false;
+  for (const MeshCandidate* k = begin; k != end; ++k) {
+    const Vec3 &v0 = soup.corners[3 * k->triangle], &v1 = soup.corners[3 * k->triangle + 1],
+               &v2 = soup.corners[3 * k->triangle + 2];
+    const Vec3 e1 = v1 - v0, e2 = v2 - v0;
+    Vec3 n = e1.cross(e2);
+    const float len = n.norm();
+    if (!(len > 1e-12f)) continue;
+    n *= k->side / len;  // towards the side the particle started the step on
+    const float d = n.dot(bn - v0);
+    if (d >= margin) continue;  // on its side and clear of the plane: clear of the triangle
+    // The projection's barycentric weights (wb along e1, wc along e2).
+    const Vec3 r = bn - v0;
+    const float d00 = e1.dot(e1), d01 = e1.dot(e2), d11 = e2.dot(e2), d20 = r.dot(e1), d21 = r.dot(e2);
+    const float den = d00 * d11 - d01 * d01;
+    const float wb = (d11 * d20 - d01 * d21) / den, wc = (d00 * d21 - d01 * d20) / den;
+    if (wb >= -kOverFace && wc >= -kOverFace && wb + wc <= 1.0f + kOverFace) {
+      // Over the face: back to its side (a particle that crossed the face in this step comes back), at least
+      // the margin away.
+      bn += (margin - d) * n;
+      normal = n;
+      plane = Eigen::Vector4f(n.x(), n.y(), n.z(), n.dot(v0));
+    } else {
+      // Beside an edge or a corner: out along the plain distance, unless behind the plane there (past the
+      // mesh's border, or over a neighbour, whose face brings it back).
+      const TriangleNearest w = nearestOnTriangle(bn, v0, v1, v2);
+      const Vec3 q = w.wa * v0 + w.wb * v1 + w.wc * v2;
+      const Vec3 e = bn - q;
+      const float dist = e.norm();
+      if (d < 0.0f || !(dist < margin && dist > 1e-9f)) continue;
+      normal = e / dist;
+      bn = q + margin * normal;
+      plane = Eigen::Vector4f(normal.x(), normal.y(), normal.z(), normal.dot(q));
+    }
+    touched = true;
+  }
+  return touched;
 }
 
 /// Pushes the contact's particle back out of its collider (pose at the substep's end) if the constraint
@@ -237,18 +290,32 @@ void reprojectOne(const Collider& c, const Pose& B, float margin, float* px, flo
   pz[i] = xn.z();
 }
 
+/// A triangle mesh's contact: out of its contact plane (n, offset in the mesh's frame at B) to the margin.
+inline void reprojectPlane(const Eigen::Vector4f& plane, const Pose& B, float margin, float* px, float* py, float* pz,
+                           std::uint32_t i) {
+  const Vec3 b = B.applyInverse(Vec3(px[i], py[i], pz[i]));
+  const Vec3 n = plane.head<3>();
+  const float d = n.dot(b) - plane[3];
+  if (d >= margin) return;
+  const Vec3 xn = B.apply(b + (margin - d) * n);
+  px[i] = xn.x();
+  py[i] = xn.y();
+  pz[i] = xn.z();
+}
+
 }  // namespace
 
 BodyCollision::BodyCollision(std::size_t particles) {
   colliderEnd_.reserve(64);
   contacts_.reserve(4 * particles);
+  contactPlanes_.reserve(4 * particles);
   distance2_.resize(static_cast<Eigen::Index>(particles));
   candidates_.reserve(particles);
 }
 
 void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settings, float h, float s0, float s1,
                             ColliderSpan colliders, bool explicitMode) {
-  PassArrays q{&contacts_, 0, 0.0f, &distance2_, &candidates_};
+  PassArrays q{&contacts_, &contactPlanes_, 0, 0.0f, &distance2_, &candidates_};
   float maxTravel2 = 0.0f;
   for (Eigen::Index i = 0; i < p.n; ++i) {
     const float dx = p.px[i] - p.sx[i], dy = p.py[i] - p.sy[i], dz = p.pz[i] - p.sz[i];
@@ -257,6 +324,7 @@ void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settin
   q.maxTravel = std::sqrt(maxTravel2);
   const float invH = 1.0f / h;
   contacts_.clear();
+  contactPlanes_.clear();
   colliderEnd_.clear();
   for (const Collider& c : colliders) {
     colliderEnd_.push_back(Pose::interpolate(c.previous, c.current, s1));
@@ -270,12 +338,85 @@ void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settin
       case ColliderShape::Cylinder: collideWith<ColliderShape::Cylinder>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
       case ColliderShape::Box: collideWith<ColliderShape::Box>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
       case ColliderShape::Plane: collideWith<ColliderShape::Plane>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::ConvexHull: collideWith<ColliderShape::ConvexHull>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::TriangleMesh: collideMesh(c, p, q.collider, s0, s1, margin, mu, invH, explicitMode); break;
     }
   }
 }
 
+void BodyCollision::beginStep(const CapeState& state, ColliderSpan colliders, const CapeSettings& settings, float dt,
+                              float slack) {
+  // Each free particle's candidate triangles of each mesh: those whose box overlaps the box of the
+  // particle's predicted path over the step in the mesh's frame (from where it is, at the mesh's start pose,
+  // to x + v dt + g dt^2 / 2 at its end pose), grown by the margin, the slack and half the path (the
+  // solver's corrections). Each with the side of its plane the particle is on now.
+  meshSlot_.assign(colliders.size, -1);
+  meshStart_.clear();
+  meshCandidates_.clear();
+  const Eigen::Index n = state.positions.rows();
+  int slots = 0;
+  for (std::size_t ci = 0; ci < colliders.size; ++ci) {
+    const Collider& c = colliders.data[ci];
+    if (c.shape != ColliderShape::TriangleMesh || !c.validate().ok()) continue;
+    meshSlot_[ci] = slots++;
+    const float margin = settings.collisionThickness + c.thickness;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      meshStart_.push_back(static_cast<std::uint32_t>(meshCandidates_.size()));
+      if (state.inverseMasses[i] == 0.0f) continue;
+      const Vec3 x = state.positions.row(i).transpose();
+      const Vec3 predicted = x + dt * Vec3(state.velocities.row(i).transpose()) + (0.5f * dt * dt) * settings.gravity;
+      const Vec3 p0 = c.previous.applyInverse(x), p1 = c.current.applyInverse(predicted);
+      if (!p0.allFinite() || !p1.allFinite()) continue;
+      const float grow = margin + slack + 0.5f * (p1 - p0).norm();
+      gatherTriangles(*c.triangles, p0, p0.cwiseMin(p1).array() - grow, p0.cwiseMax(p1).array() + grow);
+    }
+    meshStart_.push_back(static_cast<std::uint32_t>(meshCandidates_.size()));
+  }
+}
+
+void BodyCollision::gatherTriangles(const TriangleSoup& soup, const Vec3& p0, const Vec3& lo, const Vec3& hi) {
+  for (std::size_t t = 0; t < soup.size(); ++t) {
+    const Vec3 &a = soup.corners[3 * t], &b = soup.corners[3 * t + 1], &c = soup.corners[3 * t + 2];
+    if ((a.cwiseMin(b).cwiseMin(c).array() > hi.array()).any() || (a.cwiseMax(b).cwiseMax(c).array() < lo.array()).any())
+      continue;
+    const float side = (b - a).cross(c - a).dot(p0 - a) >= 0.0f ? 1.0f : -1.0f;
+    meshCandidates_.push_back({static_cast<std::uint32_t>(t), side});
+  }
+}
+
+void BodyCollision::collideMesh(const Collider& c, const CollisionArrays& p, std::uint32_t ci, float s0, float s1,
+                                float margin, float mu, float invH, bool explicitMode) {
+  if (ci >= meshSlot_.size() || meshSlot_[ci] < 0) return;  // not seen by beginStep: no candidates
+  const Sweep w(c, s0, s1, margin);
+  const std::uint32_t* start = &meshStart_[static_cast<std::size_t>(meshSlot_[ci]) * static_cast<std::size_t>(p.n + 1)];
+  for (Eigen::Index i = 0; i < p.n; ++i) {
+    if (start[i] == start[i + 1] || p.w[i] == 0.0f) continue;
+    const Vec3 x(p.px[i], p.py[i], p.pz[i]);
+    const Vec3 a = w.invRA * (Vec3(p.sx[i], p.sy[i], p.sz[i]) - w.A.position);
+    const Vec3 b = w.invRB * (x - w.B.position);
+    Vec3 bn, normal;
+    Eigen::Vector4f plane;
+    if (!resolveMesh(*c.triangles, &meshCandidates_[start[i]], meshCandidates_.data() + start[i + 1], margin, b, bn,
+                     normal, plane))
+      continue;
+    applyFriction(mu, a, b, normal, bn);
+    const Vec3 xn = w.RB * bn + w.B.position;
+    if (explicitMode) {
+      p.vx[i] += (xn.x() - x.x()) * invH;
+      p.vy[i] += (xn.y() - x.y()) * invH;
+      p.vz[i] += (xn.z() - x.z()) * invH;
+    }
+    p.px[i] = xn.x();
+    p.py[i] = xn.y();
+    p.pz[i] = xn.z();
+    contacts_.push_back({static_cast<std::uint32_t>(i), ci});
+    contactPlanes_.push_back(plane);
+  }
+}
+
 void BodyCollision::reproject(const CollisionArrays& p, const CapeSettings& settings, ColliderSpan colliders) {
-  for (const Cape::Contact& k : contacts_) {
+  for (std::size_t j = 0; j < contacts_.size(); ++j) {
+    const Cape::Contact& k = contacts_[j];
     const Collider& c = colliders.data[k.collider];
     const Pose& B = colliderEnd_[k.collider];
     const float margin = settings.collisionThickness + c.thickness;
@@ -285,6 +426,8 @@ void BodyCollision::reproject(const CollisionArrays& p, const CapeSettings& sett
       case ColliderShape::Cylinder: reprojectOne<ColliderShape::Cylinder>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
       case ColliderShape::Box: reprojectOne<ColliderShape::Box>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
       case ColliderShape::Plane: reprojectOne<ColliderShape::Plane>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
+      case ColliderShape::ConvexHull: reprojectOne<ColliderShape::ConvexHull>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
+      case ColliderShape::TriangleMesh: reprojectPlane(contactPlanes_[j], B, margin, p.px, p.py, p.pz, k.particle); break;
     }
   }
 }

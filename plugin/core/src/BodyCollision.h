@@ -25,9 +25,21 @@ struct CollisionArrays {
   Eigen::Index n;
 };
 
+/// A triangle a particle may meet in this step, with the side of its plane (+1 front, -1 back, by the
+/// corners' counter-clockwise order) the particle was on at the step's start.
+struct MeshCandidate {
+  std::uint32_t triangle;
+  float side;
+};
+
 class BodyCollision {
  public:
   explicit BodyCollision(std::size_t particles);
+
+  /// Once per step, before the substeps: every free particle's candidate triangles of every triangle-mesh
+  /// collider (the other shapes need nothing). `slack`, m, covers how far the solver's corrections may carry
+  /// a particle beyond its predicted path.
+  void beginStep(const CapeState& state, ColliderSpan colliders, const CapeSettings& settings, float dt, float slack);
 
   /// The substep [s0, s1] of the step (fractions of it; h seconds long): every free particle of `p` against
   /// every valid collider's sweep. An invalid collider (NaN pose, bad size) is skipped. In the explicit
@@ -45,6 +57,16 @@ class BodyCollision {
   std::vector<Cape::Contact> contacts_;    ///< Contacts of the substep's collision pass.
   Eigen::ArrayXf distance2_;               ///< Broad-phase scratch, one per particle.
   std::vector<std::uint32_t> candidates_;  ///< Broad-phase scratch.
+  std::vector<Eigen::Vector4f> contactPlanes_;  ///< Per contact: a mesh's contact plane (n, offset), else 0.
+  // Triangle meshes: per mesh (in collider order), particle i's candidates are
+  // meshCandidates_[meshStart_[slot * (n + 1) + i] .. meshStart_[slot * (n + 1) + i + 1]).
+  std::vector<int> meshSlot_;              ///< Per collider of the step: its mesh slot, or -1.
+  std::vector<std::uint32_t> meshStart_;
+  std::vector<MeshCandidate> meshCandidates_;
+
+  void gatherTriangles(const TriangleSoup& soup, const Vec3& p0, const Vec3& lo, const Vec3& hi);
+  void collideMesh(const Collider& c, const CollisionArrays& p, std::uint32_t collider, float s0, float s1,
+                   float margin, float mu, float invH, bool explicitMode);
 };
 
 }  // namespace cape::detail

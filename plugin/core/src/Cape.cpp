@@ -159,7 +159,7 @@ void Cape::teleport(const Pose& delta) {
 void Cape::step(float dt, ColliderSpan colliders) {
   if (!ok() || !std::isfinite(dt) || !(dt > 0.0f)) return;
   const StepPlan plan = planSubsteps(dt);
-  beginStep(plan, dt);
+  beginStep(plan, dt, colliders);
   int searchEvery = 0;  // substeps between self-contact searches inside the loop; 0: none there
   if (settings_.selfCollision && settings_.integrator == Integrator::Xpbd)
     searchEvery = work_->self.schedule(state_, work_->freeMask, settings_, dt, plan.substeps);
@@ -192,7 +192,7 @@ Cape::StepPlan Cape::planSubsteps(float dt) const {
   return {substeps, dt / static_cast<float>(substeps)};
 }
 
-void Cape::beginStep(const StepPlan& plan, float dt) {
+void Cape::beginStep(const StepPlan& plan, float dt, ColliderSpan colliders) {
   // 1 for free particles, 0 for pinned ones (same size every step: no allocation).
   work_->freeMask = (state_.inverseMasses.array() > 0.0f).cast<float>();
   if (settings_.integrator == Integrator::Xpbd) prepareSpringDenominators(plan.h);
@@ -200,6 +200,9 @@ void Cape::beginStep(const StepPlan& plan, float dt) {
   // far slower than a frame.
   if (settings_.wind.model != WindSettings::Model::None)
     windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt), work_->airVelocity);
+  // Triangle meshes: each particle's candidate triangles for the whole step, found once. The slack, a
+  // quarter of the spacing, is the self-collision search's for the same reason.
+  work_->body.beginStep(state_, colliders, settings_, dt, 0.25f * fabric_->meanSpacing());
 }
 
 void Cape::endStep(float dt) {

@@ -14,8 +14,47 @@ const char* toString(ColliderShape shape) {
     case ColliderShape::Cylinder: return "cylinder";
     case ColliderShape::Box: return "box";
     case ColliderShape::Plane: return "plane";
+    case ColliderShape::ConvexHull: return "convex_hull";
+    case ColliderShape::TriangleMesh: return "triangle_mesh";
   }
   return "?";
+}
+
+std::shared_ptr<const ConvexHull> ConvexHull::make(std::vector<Vec3> vertices, std::vector<Eigen::Vector4f> planes) {
+  auto hull = std::make_shared<ConvexHull>();
+  hull->vertices = std::move(vertices);
+  hull->planes = std::move(planes);
+  for (const Vec3& v : hull->vertices) hull->radius = std::max(hull->radius, v.norm());
+  return hull;
+}
+
+Status ConvexHull::validate() const {
+  if (vertices.size() < 4 || planes.size() < 4) return Status::error("needs at least 4 vertices and 4 planes");
+  for (const Vec3& v : vertices)
+    if (!v.allFinite()) return Status::error("a vertex is not finite");
+  for (const Eigen::Vector4f& p : planes) {
+    if (!p.allFinite()) return Status::error("a plane is not finite");
+    if (std::abs(p.head<3>().norm() - 1.0f) > 1e-3f) return Status::error("a plane normal is not a unit vector");
+    for (const Vec3& v : vertices)
+      if (p.head<3>().dot(v) - p[3] > 1e-4f) return Status::error("a vertex lies outside a face plane");
+  }
+  return Status::success();
+}
+
+Collider Collider::convexHull(std::shared_ptr<const ConvexHull> hull, const Pose& pose) {
+  Collider c;
+  c.shape = ColliderShape::ConvexHull;
+  c.hull = std::move(hull);
+  c.previous = c.current = pose;
+  return c;
+}
+
+Collider Collider::triangleMesh(std::shared_ptr<const TriangleSoup> triangles, const Pose& pose) {
+  Collider c;
+  c.shape = ColliderShape::TriangleMesh;
+  c.triangles = std::move(triangles);
+  c.previous = c.current = pose;
+  return c;
 }
 
 Collider Collider::sphere(float radius, const Pose& pose) {
@@ -88,6 +127,12 @@ Status Collider::validate() const {
       if (!normal.allFinite() || std::abs(normal.norm() - 1.0f) > 1e-3f) return bad("normal must be a unit vector");
       if (!std::isfinite(constant)) return bad("constant must be finite");
       break;
+    case ColliderShape::ConvexHull:
+      if (!hull) return bad("no hull");
+      break;  // the hull itself is checked where it is built (ConvexHull::validate): it is shared
+    case ColliderShape::TriangleMesh:
+      if (!triangles) return bad("no triangles");
+      break;
   }
   return Status::success();
 }
@@ -100,6 +145,8 @@ SurfaceDistance localSignedDistance(const Collider& c, const Vec3& p) {
     case ColliderShape::Cylinder: return shapeDistance<ColliderShape::Cylinder>(c, p);
     case ColliderShape::Box: return shapeDistance<ColliderShape::Box>(c, p);
     case ColliderShape::Plane: return shapeDistance<ColliderShape::Plane>(c, p);
+    case ColliderShape::ConvexHull: return shapeDistance<ColliderShape::ConvexHull>(c, p);
+    case ColliderShape::TriangleMesh: return detail::meshDistance(*c.triangles, p);
   }
   return {0.0f, Vec3::UnitY()};
 }

@@ -2,9 +2,11 @@
 #pragma once
 
 #include "cape/core/Collider.h"
+#include "cape/core/Geometry.h"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cape::detail {
 
@@ -55,6 +57,36 @@ inline SurfaceDistance cylinderDistance(float r, float hh, int axis, const Vec3&
   return {da, capNormal};
 }
 
+/// The largest plane distance of a convex hull and that plane's normal: the exact signed distance inside and
+/// over a face, a lower bound of it beside an edge or a corner outside (so pushing a point out to a margin
+/// by it keeps the point at least that far from the true surface).
+inline SurfaceDistance hullDistance(const ConvexHull& h, const Vec3& p) {
+  float best = -std::numeric_limits<float>::infinity();
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < h.planes.size(); ++i) {
+    const Eigen::Vector4f& q = h.planes[i];
+    const float d = q[0] * p.x() + q[1] * p.y() + q[2] * p.z() - q[3];
+    if (d > best) {
+      best = d;
+      k = i;
+    }
+  }
+  return {best, h.planes.empty() ? Vec3::UnitY() : Vec3(h.planes[k].head<3>())};
+}
+
+/// Unsigned distance to the nearest triangle of a soup (+inf when it has none), and the direction to the
+/// point from there.
+inline SurfaceDistance meshDistance(const TriangleSoup& m, const Vec3& p) {
+  SurfaceDistance best{std::numeric_limits<float>::infinity(), Vec3::UnitY()};
+  for (std::size_t t = 0; t < m.size(); ++t) {
+    const Vec3 &a = m.corners[3 * t], &b = m.corners[3 * t + 1], &c = m.corners[3 * t + 2];
+    const TriangleNearest w = nearestOnTriangle(p, a, b, c);
+    const Vec3 e = p - (w.wa * a + w.wb * b + w.wc * c);
+    const float d = e.norm();
+    if (d < best.distance) best = {d, directionOr(e, (b - a).cross(c - a).normalized())};
+  }
+  return best;
+}
 
 template <ColliderShape S>
 inline SurfaceDistance shapeDistance(const Collider& c, const Vec3& p) {
@@ -69,7 +101,10 @@ inline SurfaceDistance shapeDistance(const Collider& c, const Vec3& p) {
     return cylinderDistance(c.radius, c.halfHeight, c.axis, p);
   } else if constexpr (S == ColliderShape::Box) {
     return boxDistance(c.halfExtents, p);
+  } else if constexpr (S == ColliderShape::ConvexHull) {
+    return hullDistance(*c.hull, p);
   } else {
+    static_assert(S == ColliderShape::Plane, "triangle meshes have no closed-form distance: meshDistance");
     return {c.normal.dot(p) - c.constant, c.normal};
   }
 }

@@ -106,7 +106,7 @@ class Cape {
     float h = 0.0f;
   };
   StepPlan planSubsteps(float dt) const;
-  void beginStep(const StepPlan& plan, float dt);
+  void beginStep(const StepPlan& plan, float dt, ColliderSpan colliders);
   void endStep(float dt);
   // The stages of one substep [s0, s1] (fractions of the step) of length h.
   void substepXpbd(float h, float s0, float s1, ColliderSpan colliders);

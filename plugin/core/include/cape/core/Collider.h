@@ -6,13 +6,35 @@
 
 #include "cape/core/Types.h"
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace cape {
 
-enum class ColliderShape : int { Sphere, Capsule, Cylinder, Box, Plane };
+enum class ColliderShape : int { Sphere, Capsule, Cylinder, Box, Plane, ConvexHull, TriangleMesh };
 const char* toString(ColliderShape shape);
+
+/// A convex polytope in its collider's frame: the points it is the hull of, and its outward face planes
+/// n . p = offset (n a unit vector; the solid is where every n . p <= offset). Built once and shared by every
+/// collider (and every cape) that uses it; the Bullet adapter builds it from any convex shape.
+struct ConvexHull {
+  std::vector<Vec3> vertices;           ///< m, at least 4, not all in one plane.
+  std::vector<Eigen::Vector4f> planes;  ///< (n.x, n.y, n.z, offset in m), at least 4.
+  float radius = 0.0f;                  ///< m: the largest |vertex| (a bounding sphere about the origin).
+
+  /// A hull from its vertices and planes; radius from the vertices.
+  static std::shared_ptr<const ConvexHull> make(std::vector<Vec3> vertices, std::vector<Eigen::Vector4f> planes);
+  /// Counts, finite values, unit normals, and every vertex on the solid side of every plane (within 0.1 mm).
+  Status validate() const;
+};
+
+/// Triangles of a mesh near the cape, in their collider's frame: corners[3 t .. 3 t + 2] is triangle t, m.
+/// Whoever gathers them (the Bullet adapter, from its mesh queries once per step) refills it between steps.
+struct TriangleSoup {
+  std::vector<Vec3> corners;
+  std::size_t size() const { return corners.size() / 3; }
+};
 
 /// One collider. All sizes are in metres and describe the true surface; `thickness` adds a skin the
 /// particles are kept out of (on top of the cape's own collision thickness).
@@ -24,6 +46,11 @@ const char* toString(ColliderShape shape);
 ///   Cylinder radius `radius` about `axis`, from -halfHeight to +halfHeight along it
 ///   Box      |p_k| <= halfExtents_k
 ///   Plane    the half-space n . p <= constant is solid (n = `normal`, unit length)
+///   ConvexHull    the intersection of `hull`'s half-spaces; its signed distance is the largest plane
+///                 distance (exact inside and over a face, a lower bound beside edges and corners outside)
+///   TriangleMesh  `triangles`, two-sided: each particle keeps the side of every nearby triangle it was on
+///                 at the start of the step (so a thin wall or a floor cannot be passed through), at least
+///                 the thicknesses away from it; no inside
 struct Collider {
   ColliderShape shape = ColliderShape::Sphere;
   float radius = 0.0f;
@@ -32,6 +59,8 @@ struct Collider {
   Vec3 halfExtents = Vec3::Zero();
   Vec3 normal = Vec3::UnitY();
   float constant = 0.0f;
+  std::shared_ptr<const ConvexHull> hull;        ///< ConvexHull only.
+  std::shared_ptr<const TriangleSoup> triangles; ///< TriangleMesh only.
   float thickness = 0.0f;  ///< m, >= 0.
   float friction = -1.0f;  ///< Coulomb coefficient; negative means "use the cape's setting".
   Pose previous;           ///< Pose at the start of the step.
@@ -44,6 +73,8 @@ struct Collider {
   static Collider box(const Vec3& halfExtents, const Pose& pose = Pose());
   /// The world plane n . x = constant, solid below (n is normalised here).
   static Collider plane(const Vec3& normal, float constant);
+  static Collider convexHull(std::shared_ptr<const ConvexHull> hull, const Pose& pose = Pose());
+  static Collider triangleMesh(std::shared_ptr<const TriangleSoup> triangles, const Pose& pose = Pose());
 
   /// The collider has moved: the pose at the end of the last step becomes the start of the next.
   void moveTo(const Pose& pose) {
@@ -59,6 +90,7 @@ struct Collider {
 
 /// Signed distance from a point in the collider's local frame to its true surface (negative inside), and the
 /// outward unit normal of the nearest surface point (the nearest surface point is p - distance * normal).
+/// A triangle mesh has no inside: the distance to its nearest triangle (+inf for an empty one).
 struct SurfaceDistance {
   float distance;
   Vec3 normal;
