@@ -29,7 +29,7 @@ GaitParams GaitParams::forSpeed(double speed, double stepFrequency, double turnR
 
 Gait::Gait(const GaitParams& params) : params_(params) {
   if (params_.turnRate == 0.0) {
-    // No turn: the core's straight line, so the root path is bit for bit the scenes'.
+    // No turn: motionAt's straight line, so the root path is bit for bit the scenes'.
     useMotion_ = true;
     motion_.speed = static_cast<float>(params_.speed);
     motion_.legFrequency = static_cast<float>(params_.stepFrequency);

@@ -6,7 +6,7 @@
 #pragma once
 
 #include "cape/core/CapeMesh.h"
-#include "cape/core/Metrics.h"
+#include "cape/scenes/Metrics.h"
 
 #include <nlohmann/json.hpp>
 

@@ -2,8 +2,8 @@
 // in a Bullet world (BulletScene.h), the cape attached through the Bullet adapter.
 #pragma once
 
-#include "cape/core/Metrics.h"
-#include "cape/core/Scene.h"
+#include "cape/scenes/Metrics.h"
+#include "cape/scenes/Scene.h"
 
 #include <memory>
 #include <string>

@@ -4,7 +4,7 @@
 // scales with N); BM_WalkFrameAdaptive uses the default strain-adaptive substepping, which refines larger
 // capes (more rows for one Gauss-Seidel pass to carry) to hold the strain under 5 %. Reported: time per frame
 // and particles per second.
-#include "cape/core/Scene.h"
+#include "cape/scenes/Scene.h"
 
 #include <benchmark/benchmark.h>
 

@@ -7,8 +7,8 @@
 // bob and move at 1.4 m/s), no colliders, 1/60 s frames, same stiffness, mass and damping. Reported per
 // configuration: time per frame and the strain of SCENARIOS.md (median and p95 over frames of the per-frame
 // maximum structural strain).
-#include "cape/core/Metrics.h"
-#include "cape/core/Scene.h"
+#include "cape/scenes/Metrics.h"
+#include "cape/scenes/Scene.h"
 
 #include <Eigen/SparseCholesky>
 #include <benchmark/benchmark.h>

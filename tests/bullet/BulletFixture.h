@@ -3,7 +3,7 @@
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
-#include "cape/core/Scene.h"
+#include "cape/scenes/Scene.h"
 
 #include <BulletSoftBody/btDeformableBodySolver.h>
 #include <BulletSoftBody/btDeformableMultiBodyConstraintSolver.h>

@@ -2,7 +2,7 @@
 // btDiscreteDynamicsWorld, two kinematic shoulder spheres and a torso box, a cape attached in a few lines.
 // Checks that the cape hangs from the shoulders behind the torso after two seconds. Exit status 0 on success.
 #include <cape/bullet/CapeAction.h>
-#include <cape/core/Scene.h>
+#include <cape/scenes/Scene.h>
 
 #include <btBulletDynamicsCommon.h>
 

@@ -1,7 +1,7 @@
 // Builds a canonical cape from the installed headers and library, hangs it from two pins for one second and
 // checks that it fell and stayed finite. Exit status 0 on success.
 #include <cape/core/Cape.h>
-#include <cape/core/Metrics.h>
+#include <cape/scenes/Metrics.h>
 
 #include <cstdio>
 

@@ -2,7 +2,7 @@
 // test that keeps fast colliders from carrying particles through, and Coulomb friction.
 #include "CapeTestFixture.h"
 
-#include "cape/core/Metrics.h"
+#include "cape/scenes/Metrics.h"
 
 #include <cmath>
 #include <string>

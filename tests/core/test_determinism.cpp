@@ -1,7 +1,7 @@
 // Determinism: the same inputs give the same bits, whichever order capes are stepped in.
 #include "CapeTestFixture.h"
 
-#include "cape/core/Scene.h"
+#include "cape/scenes/Scene.h"
 
 namespace cape {
 namespace {

@@ -2,7 +2,7 @@
 #include "CapeTestFixture.h"
 
 #include "cape/core/CapeMesh.h"
-#include "cape/core/Scene.h"
+#include "cape/scenes/Scene.h"
 
 namespace cape {
 namespace {

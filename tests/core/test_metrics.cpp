@@ -2,7 +2,7 @@
 // triangle-triangle test and the self-intersection count, and the run summary.
 #include "CapeTestFixture.h"
 
-#include "cape/core/Metrics.h"
+#include "cape/scenes/Metrics.h"
 
 #include <cmath>
 

@@ -2,8 +2,8 @@
 // promises there (issue 2): walk strain median <= 3 %, p95 <= 5 %; sprint-turn penetration <= 1 mm.
 #include "CapeTestFixture.h"
 
-#include "cape/core/Metrics.h"
-#include "cape/core/Scene.h"
+#include "cape/scenes/Metrics.h"
+#include "cape/scenes/Scene.h"
 
 #include <cmath>
 

@@ -3,8 +3,8 @@
 #include "CapeTestFixture.h"
 
 #include "cape/core/Geometry.h"
-#include "cape/core/Metrics.h"
-#include "cape/core/Scene.h"
+#include "cape/scenes/Metrics.h"
+#include "cape/scenes/Scene.h"
 
 #include <algorithm>
 #include <cmath>

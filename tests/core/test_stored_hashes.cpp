@@ -2,7 +2,7 @@
 // every bit of them. A change of behaviour on purpose updates the table in the same commit and says why in
 // its message. (Hashes are of this toolchain's IEEE single-precision arithmetic with -ffp-contract=off: the
 // same on every x86-64 build of the core, Release or Debug.)
-#include "cape/core/Scene.h"
+#include "cape/scenes/Scene.h"
 
 #include <gtest/gtest.h>
 

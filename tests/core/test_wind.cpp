@@ -2,9 +2,9 @@
 // balances, the gust field's determinism, and the seed's sine-wave mode.
 #include "CapeTestFixture.h"
 
-#include "cape/core/Metrics.h"
-#include "cape/core/Scene.h"
 #include "cape/core/Wind.h"
+#include "cape/scenes/Metrics.h"
+#include "cape/scenes/Scene.h"
 
 #include <cmath>
 

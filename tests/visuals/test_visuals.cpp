@@ -5,7 +5,7 @@
 #include "Renderer.h"
 #include "ShapeMesh.h"
 
-#include "cape/core/Scene.h"
+#include "cape/scenes/Scene.h"
 
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>

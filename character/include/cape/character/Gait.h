@@ -2,7 +2,7 @@
 // with no state and no dependence on the step size.
 //
 // Root motion. The character frame (origin on the ground between the feet, facing -Z at yaw 0) follows the
-// canonical scenes exactly: for a scene, or for any gait that does not turn, it is the core's
+// canonical scenes exactly: for a scene, or for any gait that does not turn, it is the scenes' (cape::scenes)
 // cape::motionAt(MotionDesc, t) (shared/SCENARIOS.md: walk at 1.4 m/s, sprint-turn at 5 m/s with a 180 degree
 // turn in the last 0.5 s of every 2 s), with the torso bob added to the root height, as the simple body does.
 // A gait with a constant turn rate w follows the exact arc: yaw = w t, and with forward = (-sin yaw, 0, -cos
@@ -23,7 +23,7 @@
 #include "cape/character/JointMapping.h"
 #include "cape/character/Skeleton.h"
 
-#include "cape/core/Scene.h"
+#include "cape/scenes/Scene.h"
 
 #include <array>
 
@@ -55,7 +55,7 @@ struct RootPose {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   double yaw = 0.0;
   double bob = 0.0;
-  /// Where the URDF origin goes: position raised by the bob (for a core motion, summed in float exactly as
+  /// Where the URDF origin goes: position raised by the bob (for a scene motion, summed in float exactly as
   /// cape::BodyPose::frame() does, so the simple body and the URDF body share their frame to the last bit).
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
 };
@@ -67,7 +67,7 @@ class Gait {
   explicit Gait(const GaitParams& params);
   /// A canonical scene's motion (cape::MotionDesc::forScene): hang, walk, sprint-turn, wind, crowd.
   static Gait forScene(cape::SceneKind kind);
-  /// Any core motion description; amplitudes from GaitParams::forSpeed.
+  /// Any scene motion description; amplitudes from GaitParams::forSpeed.
   static Gait fromMotion(const cape::MotionDesc& motion);
 
   const GaitParams& params() const { return params_; }

@@ -73,7 +73,7 @@ class Skeleton {
   // --- Root
   // ----------------------------------------------------------------------------------------------------
   /// The character frame: `position` in the world (m; the URDF origin, for the shipped humanoid the ground
-  /// point between the feet), `yaw` in rad about world +Y (0 faces -Z, as motionAt in the core's Scene.h).
+  /// point between the feet), `yaw` in rad about world +Y (0 faces -Z, as motionAt in cape/scenes/Scene.h).
   void setRoot(const Eigen::Vector3d& position, double yaw);
   /// Any rigid character frame (the URDF-to-world rotation is applied inside it).
   void setRootTransform(const Eigen::Isometry3d& root);

@@ -1,4 +1,4 @@
-#include "cape/core/Metrics.h"
+#include "cape/scenes/Metrics.h"
 
 #include <algorithm>
 #include <cmath>

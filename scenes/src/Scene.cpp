@@ -1,4 +1,4 @@
-#include "cape/core/Scene.h"
+#include "cape/scenes/Scene.h"
 
 #include <cmath>
 
