@@ -69,7 +69,7 @@ BulletScene::~BulletScene() {
 bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error) {
   options_ = o;
   motion_ = MotionDesc::forScene(o.scene);
-  rig_ = makeCapeRig(o.size, o.attachment, o.settings.bendStiffness > 0.0f);
+  rig_ = makeCapeRig(o.size, o.pinLayout, o.settings.bendStiffness > 0.0f);
   if (!rig_.fabric) {
     error = "cannot build a " + std::to_string(o.size) + " x " + std::to_string(o.size) + " cape";
     return false;
@@ -202,7 +202,7 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
         c->states.push_back(std::move(state));
         c->bodies.push_back(std::move(body));
       }
-      if (o.attachment == Attachment::Collar) {
+      if (o.pinLayout == PinLayout::Collar) {
         anchors.emplace_back(0.0f, c->bodies[SimpleBody::kTorso].get());
       } else {
         anchors.emplace_back(-1.0f, c->bodies[SimpleBody::kLeftShoulder].get());

@@ -23,7 +23,7 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
 RunOptions toRunOptions(const SceneCli& cli) {
   RunOptions o;
   parseSceneKind(cli.scene, o.scene);
-  parseAttachment(cli.attachment, o.attachment);
+  parsePinLayout(cli.attachment, o.pinLayout);
   o.size = cli.size;
   o.seconds = cli.seconds;
   o.characters = o.scene == SceneKind::Crowd ? cli.characters : 1;

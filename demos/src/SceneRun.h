@@ -15,7 +15,7 @@ namespace cape::demo {
 struct RunOptions {
   SceneKind scene = SceneKind::Walk;
   int size = 20;  ///< particles per side
-  Attachment attachment = Attachment::Corners;
+  PinLayout pinLayout = PinLayout::Corners;
   double seconds = -1.0;  ///< < 0: the scene's own length
   int characters = 1;     ///< crowd size
   int threads = 1;

@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   const std::string& attachment = sceneCli.attachment;
   const int size = sceneCli.size;
   if (solver == "explicit") {
-    o.settings = CapeSettings::seed();
+    o.settings = CapeSettings::unitySeed();
     o.settings.timeStep = 1.0f / 60.0f;
     o.settings.substeps = 8;  // 1/480 s: within the explicit springs' stability bound (0.00875 s is the seed's)
     // At 1/480 s the explicit springs stay stable up to ~57 N/m on the canonical cape's 1 g particles; the

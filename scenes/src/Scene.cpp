@@ -59,11 +59,11 @@ bool parseSceneKind(const std::string& name, SceneKind& kind) {
   return false;
 }
 
-const char* toString(Attachment a) { return a == Attachment::Corners ? "corners" : "collar"; }
+const char* toString(PinLayout layout) { return layout == PinLayout::Corners ? "corners" : "collar"; }
 
-bool parseAttachment(const std::string& name, Attachment& a) {
-  if (name == "corners") a = Attachment::Corners;
-  else if (name == "collar") a = Attachment::Collar;
+bool parsePinLayout(const std::string& name, PinLayout& layout) {
+  if (name == "corners") layout = PinLayout::Corners;
+  else if (name == "collar") layout = PinLayout::Collar;
   else return false;
   return true;
 }
@@ -179,10 +179,10 @@ void SimpleBody::moveTo(const BodyPose& pose, bool teleport) {
   }
 }
 
-CapeRig makeCapeRig(int n, Attachment attachment, bool bendSprings) {
+CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings) {
   CapeRig rig;
   const int cols = std::max(n, 2);
-  if (attachment == Attachment::Corners) {
+  if (layout == PinLayout::Corners) {
     rig.pinnedParticles = {0u, static_cast<std::uint32_t>(cols - 1)};
   } else {
     for (int c = 0; c < cols; ++c) rig.pinnedParticles.push_back(static_cast<std::uint32_t>(c));
@@ -213,11 +213,11 @@ Pose capeStartPlacement(SceneKind kind) {
   return p;
 }
 
-SimpleScene::SimpleScene(SceneKind kind, int n, Attachment attachment, const CapeSettings& settings,
+SimpleScene::SimpleScene(SceneKind kind, int n, PinLayout layout, const CapeSettings& settings,
                          const Vec3& offset)
     : kind_(kind),
       motion_(MotionDesc::forScene(kind)),
-      rig_(makeCapeRig(n, attachment, settings.bendStiffness > 0.0f)),
+      rig_(makeCapeRig(n, layout, settings.bendStiffness > 0.0f)),
       body_(offset),
       cape_(rig_.fabric, settingsForScene(kind, settings),
             Pose{offset + capeStartPlacement(kind).position, capeStartPlacement(kind).rotation}),

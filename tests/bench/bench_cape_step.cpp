@@ -14,7 +14,7 @@ using namespace cape;
 
 void runFrames(benchmark::State& state, SceneKind kind, const CapeSettings& settings) {
   const int n = static_cast<int>(state.range(0));
-  SimpleScene scene(kind, n, Attachment::Corners, settings);
+  SimpleScene scene(kind, n, PinLayout::Corners, settings);
   if (!scene.status().ok()) {
     state.SkipWithError(scene.status().message().c_str());
     return;
@@ -30,7 +30,7 @@ void runFrames(benchmark::State& state, SceneKind kind, const CapeSettings& sett
     // Loop the 10 s scene so long runs measure the same motion.
     if (++frames % 540 == 0) {
       searches += scene.cape().selfContactSearches();
-      scene = SimpleScene(kind, n, Attachment::Corners, settings);
+      scene = SimpleScene(kind, n, PinLayout::Corners, settings);
     }
   }
   state.counters["particles"] = static_cast<double>(n) * n;
@@ -70,7 +70,7 @@ void BM_SprintTurnFrameSelfCollision(benchmark::State& state) {
 void BM_SprintTurnFrame(benchmark::State& state) { runFrames(state, SceneKind::SprintTurn, CapeSettings()); }
 void BM_SprintTurnFrameFixed(benchmark::State& state) { runFrames(state, SceneKind::SprintTurn, fixedSubsteps()); }
 void BM_WalkFrameSeedExplicit(benchmark::State& state) {
-  CapeSettings s = CapeSettings::seed();
+  CapeSettings s = CapeSettings::unitySeed();
   s.timeStep = 1.0f / 60.0f;
   s.substeps = 8;  // the seed's 0.00875 s step would need ~2 steps per 1/60 s frame; 8 keeps it stable at N = 64
   runFrames(state, SceneKind::Walk, s);

@@ -145,7 +145,7 @@ void BM_WalkPinsXpbd(benchmark::State& state) {
   s.useTethers = state.range(1) != 0;
   const MotionDesc motion = MotionDesc::forScene(SceneKind::Walk);
   for (auto _ : state) {
-    const CapeRig rig = makeCapeRig(20, Attachment::Corners);
+    const CapeRig rig = makeCapeRig(20, PinLayout::Corners);
     Cape cape(rig.fabric, s, capeStartPlacement(SceneKind::Walk));
     std::vector<Vec3> targets = pinTargets(rig, motion, 0.0);
     for (std::size_t k = 0; k < targets.size(); ++k) cape.pin(rig.pinnedParticles[k], targets[k]);
@@ -171,7 +171,7 @@ void BM_WalkPinsLiu(benchmark::State& state) {
   const CapeSettings s;
   const MotionDesc motion = MotionDesc::forScene(SceneKind::Walk);
   for (auto _ : state) {
-    const CapeRig rig = makeCapeRig(20, Attachment::Corners);
+    const CapeRig rig = makeCapeRig(20, PinLayout::Corners);
     const Cape placed(rig.fabric, s, capeStartPlacement(SceneKind::Walk));
     LiuMassSpring liu(*rig.fabric, s, placed.state().positions, rig.pinnedParticles);
     Cape probe(rig.fabric, s);  // holds positions and pins for the shared metric code

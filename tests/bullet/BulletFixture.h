@@ -15,6 +15,12 @@
 #include <memory>
 #include <vector>
 
+namespace cape {
+// The pin layout's old name (it clashed with cape::bullet::Attachment, a pinned particle of the adapter), kept
+// only for the files that still say cape::Attachment (test_cape_action.cpp); remove once they say PinLayout.
+using Attachment = PinLayout;
+}  // namespace cape
+
 namespace capetest {
 
 constexpr btScalar kFrame = btScalar(1.0 / 60.0);
@@ -125,7 +131,7 @@ struct World {
 
 /// The canonical 20 x 20 cape (0.6 m x 1.0 m, 0.4 kg), tethered to its top corners.
 inline cape::FabricPtr cornerFabric(int n = 20) {
-  return cape::makeCapeRig(n, cape::Attachment::Corners).fabric;
+  return cape::makeCapeRig(n, cape::PinLayout::Corners).fabric;
 }
 
 /// Lying flat and horizontal (rotated +90 degrees about X: the grid spans x in [-0.3, 0.3], z in [-0.5,

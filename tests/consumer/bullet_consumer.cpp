@@ -38,7 +38,7 @@ int main() {
   world.addRigidBody(torso.get());
 
   // --- The README's example. ---
-  cape::CapeRig rig = cape::makeCapeRig(20, cape::Attachment::Corners);
+  cape::CapeRig rig = cape::makeCapeRig(20, cape::PinLayout::Corners);
   btTransform placement(btQuaternion::getIdentity(), btVector3(-0.30f, 1.56f, 0.15f));  // top-left corner
   cape::bullet::CapeAction cape(rig.fabric, cape::CapeSettings(), placement);
   cape.attachNearest(leftShoulder, btVector3(-0.30f, 1.56f, 0.15f));

@@ -7,7 +7,7 @@ namespace cape {
 namespace {
 
 std::uint64_t runScene(SceneKind kind, const CapeSettings& s, int frames) {
-  SimpleScene scene(kind, 16, Attachment::Corners, s);
+  SimpleScene scene(kind, 16, PinLayout::Corners, s);
   EXPECT_TRUE(scene.status().ok());
   for (int i = 0; i < frames; ++i) scene.advanceFrame();
   return test::hashPoints(scene.cape().state().positions) ^ (test::hashPoints(scene.cape().state().velocities) << 1);
@@ -19,15 +19,15 @@ TEST(Determinism, TwoRunsGiveIdenticalBits) {
     const std::uint64_t b = runScene(kind, CapeSettings(), 120);
     EXPECT_EQ(a, b) << toString(kind);
   }
-  CapeSettings seed = CapeSettings::seed();
+  CapeSettings seed = CapeSettings::unitySeed();
   seed.timeStep = 1.0f / 60.0f;
   EXPECT_EQ(runScene(SceneKind::Walk, seed, 60), runScene(SceneKind::Walk, seed, 60));
 }
 
 TEST(Determinism, InterleavedCapesDoNotInfluenceEachOther) {
   const std::uint64_t alone = runScene(SceneKind::Walk, CapeSettings(), 60);
-  SimpleScene a(SceneKind::Walk, 16, Attachment::Corners, CapeSettings());
-  SimpleScene b(SceneKind::SprintTurn, 16, Attachment::Collar, CapeSettings());
+  SimpleScene a(SceneKind::Walk, 16, PinLayout::Corners, CapeSettings());
+  SimpleScene b(SceneKind::SprintTurn, 16, PinLayout::Collar, CapeSettings());
   for (int i = 0; i < 60; ++i) {
     b.advanceFrame();
     a.advanceFrame();

@@ -44,7 +44,7 @@ TEST(CapeMesh, NormalsAreAreaWeighted) {
 
 TEST(CapeMesh, TwoSidedBackMirrorsTheFront) {
   CapeSettings s;
-  SimpleScene scene(SceneKind::Walk, 8, Attachment::Corners, s);
+  SimpleScene scene(SceneKind::Walk, 8, PinLayout::Corners, s);
   ASSERT_TRUE(scene.status().ok());
   for (int i = 0; i < 30; ++i) scene.advanceFrame();  // a crumpled, moving shape
   const Fabric& f = scene.cape().fabric();

@@ -19,10 +19,10 @@ TEST(Scenes, ParseNames) {
     EXPECT_EQ(k, kind);
   }
   EXPECT_FALSE(parseSceneKind("dance", k));
-  Attachment a;
-  EXPECT_TRUE(parseAttachment("collar", a));
-  EXPECT_EQ(a, Attachment::Collar);
-  EXPECT_FALSE(parseAttachment("belt", a));
+  PinLayout a;
+  EXPECT_TRUE(parsePinLayout("collar", a));
+  EXPECT_EQ(a, PinLayout::Collar);
+  EXPECT_FALSE(parsePinLayout("belt", a));
 }
 
 TEST(Scenes, WalkMotion) {
@@ -74,19 +74,19 @@ TEST(Scenes, SimpleBodyMatchesScenarios) {
 }
 
 TEST(Scenes, CapeRigs) {
-  const CapeRig corners = makeCapeRig(20, Attachment::Corners);
+  const CapeRig corners = makeCapeRig(20, PinLayout::Corners);
   ASSERT_TRUE(corners.fabric);
   EXPECT_EQ(corners.pinnedParticles.size(), 2u);
   EXPECT_NEAR(corners.fabric->totalMass(), 0.4f, 1e-5f);
   EXPECT_NEAR(std::fabs(corners.pinLocalPoints[0].x()), 0.30f, 1e-6f);
   EXPECT_NEAR(corners.pinLocalPoints[0].y(), 1.56f, 1e-6f);
   EXPECT_NEAR(corners.pinLocalPoints[0].z(), 0.15f, 1e-6f);
-  const CapeRig collar = makeCapeRig(20, Attachment::Collar);
+  const CapeRig collar = makeCapeRig(20, PinLayout::Collar);
   EXPECT_EQ(collar.pinnedParticles.size(), 20u);
 }
 
 RunSummary runScene(SceneKind kind, int n = 20, double seconds = -1.0, const CapeSettings& settings = CapeSettings()) {
-  SimpleScene scene(kind, n, Attachment::Corners, settings);
+  SimpleScene scene(kind, n, PinLayout::Corners, settings);
   EXPECT_TRUE(scene.status().ok());
   MetricsRecorder rec;
   SelfIntersectionCounter counter;
@@ -127,7 +127,7 @@ TEST(Scenes, StrainAdaptiveSubstepsHoldTheSprintTurn) {
   EXPECT_LE(adaptive.p95FrameMaxStrain, 0.15f);
   EXPECT_GT(plain.p95FrameMaxStrain, 2.0f * adaptive.p95FrameMaxStrain) << "the refinement must be what helps";
   // Walking never needs it: the cape ends the walk back at the settings' substeps.
-  SimpleScene walk(SceneKind::Walk, 20, Attachment::Corners, CapeSettings());
+  SimpleScene walk(SceneKind::Walk, 20, PinLayout::Corners, CapeSettings());
   for (int f = 0; f < 120; ++f) walk.advanceFrame();
   EXPECT_EQ(walk.cape().substepRefinement(), 1);
   EXPECT_LT(walk.cape().lastMaxStrain(), 0.05f);

@@ -203,7 +203,7 @@ TEST(SelfCollision, AWingOfOneHalfOfACellFoldedOntoTheOtherHalfIsAContact) {
 TEST(SelfCollision, NeighboursAreNeverContactsOnAFlatCape) {
   CapeSettings s;
   s.selfCollision = true;
-  SimpleScene scene(SceneKind::Hang, 20, Attachment::Corners, s);
+  SimpleScene scene(SceneKind::Hang, 20, PinLayout::Corners, s);
   scene.advanceFrame();
   // Falling flat from horizontal: every particle moves with its neighbours, no fold is near.
   EXPECT_EQ(scene.cape().selfContactCount(), 0u);
@@ -244,8 +244,8 @@ TEST(SelfCollision, SwitchedOffTheSolverIsBitForBitUnchanged) {
   CapeSettings off;
   CapeSettings offOtherThickness = off;
   offOtherThickness.selfCollisionThickness = 0.05f;  // read only when self-collision is on
-  SimpleScene a(SceneKind::SprintTurn, 16, Attachment::Corners, off);
-  SimpleScene b(SceneKind::SprintTurn, 16, Attachment::Corners, offOtherThickness);
+  SimpleScene a(SceneKind::SprintTurn, 16, PinLayout::Corners, off);
+  SimpleScene b(SceneKind::SprintTurn, 16, PinLayout::Corners, offOtherThickness);
   for (int i = 0; i < 120; ++i) {
     a.advanceFrame();
     b.advanceFrame();
@@ -259,7 +259,7 @@ TEST(SelfCollision, SwitchedOffTheSolverIsBitForBitUnchanged) {
 TEST(SelfCollision, HugeMotionStaysBoundedAndFinite) {
   CapeSettings s;
   s.selfCollision = true;
-  SimpleScene scene(SceneKind::Walk, 12, Attachment::Corners, s);
+  SimpleScene scene(SceneKind::Walk, 12, PinLayout::Corners, s);
   Points& v = scene.cape().mutableState().velocities;
   for (Eigen::Index i = 0; i < v.rows(); i += 2) v.row(i) << 400.0f, -300.0f, 500.0f;
   for (int f = 0; f < 5; ++f) scene.advanceFrame();
@@ -271,7 +271,7 @@ TEST(SelfCollision, HugeMotionStaysBoundedAndFinite) {
 TEST(SelfCollision, ANonFiniteCapeFindsNoContacts) {
   CapeSettings s;
   s.selfCollision = true;
-  SimpleScene scene(SceneKind::Walk, 8, Attachment::Corners, s);
+  SimpleScene scene(SceneKind::Walk, 8, PinLayout::Corners, s);
   scene.advanceFrame();
   scene.cape().mutableState().velocities(5, 1) = std::nanf("");
   scene.advanceFrame();
@@ -304,7 +304,7 @@ class SelfCollisionScenes : public ::testing::TestWithParam<SceneKind> {};
 TEST_P(SelfCollisionScenes, ZeroSelfIntersectionsInEveryFrame) {
   CapeSettings s;
   s.selfCollision = true;
-  SimpleScene scene(GetParam(), 20, Attachment::Corners, s);
+  SimpleScene scene(GetParam(), 20, PinLayout::Corners, s);
   ASSERT_TRUE(scene.status().ok());
   SelfIntersectionCounter counter;
   MetricsRecorder rec;

@@ -20,9 +20,9 @@ void expectRejected(const CapeSettings& s, const char* field) {
 
 TEST(Settings, DefaultsAndSeedAreValid) {
   EXPECT_TRUE(CapeSettings().validate().ok());
-  EXPECT_TRUE(CapeSettings::seed().validate().ok());
+  EXPECT_TRUE(CapeSettings::unitySeed().validate().ok());
   // The seed's set-up: explicit springs, 4 steps of 0.00875 s per 0.035 s frame.
-  const CapeSettings seed = CapeSettings::seed();
+  const CapeSettings seed = CapeSettings::unitySeed();
   EXPECT_EQ(seed.integrator, Integrator::ExplicitSpring);
   EXPECT_FLOAT_EQ(seed.timeStep / static_cast<float>(seed.substeps), 0.00875f);
 }

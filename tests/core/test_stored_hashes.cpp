@@ -30,7 +30,7 @@ constexpr StoredScene kStored[] = {
 std::uint64_t runScene(SceneKind kind, bool selfCollision) {
   CapeSettings settings;
   settings.selfCollision = selfCollision;
-  SimpleScene scene(kind, 20, Attachment::Corners, settingsForScene(kind, settings));
+  SimpleScene scene(kind, 20, PinLayout::Corners, settingsForScene(kind, settings));
   EXPECT_TRUE(scene.status().ok());
   for (int f = 0; f < 180; ++f) scene.advanceFrame();
   return stateHash(scene.cape().state());

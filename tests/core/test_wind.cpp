@@ -180,7 +180,7 @@ TEST(Wind, SeedSineWaveWindPushesEachParticlesAreaShare) {
 }
 
 TEST(Wind, WindSceneBlowsTheCapeDownwindWithoutPenetration) {
-  SimpleScene scene(SceneKind::Wind, 20, Attachment::Corners, CapeSettings());
+  SimpleScene scene(SceneKind::Wind, 20, PinLayout::Corners, CapeSettings());
   ASSERT_TRUE(scene.status().ok());
   EXPECT_EQ(scene.cape().settings().wind.model, WindSettings::Model::Aerodynamic);
   MetricsRecorder rec;

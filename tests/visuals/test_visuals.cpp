@@ -82,7 +82,7 @@ TEST(ShapeMesh, VerticesOnTheTrueSurfaceAndTrianglesFacingOut) {
 }
 
 TEST(GltfExport, RunLoadsBackWithNodesMeshesAnimationAndFrameTimes) {
-  SimpleScene scene(SceneKind::Walk, 8, Attachment::Corners, CapeSettings());
+  SimpleScene scene(SceneKind::Walk, 8, PinLayout::Corners, CapeSettings());
   ASSERT_TRUE(scene.status().ok());
   const int frames = 30;
   GltfRecorder recorder(1);
@@ -171,7 +171,7 @@ TEST(GltfExport, RunLoadsBackWithNodesMeshesAnimationAndFrameTimes) {
 }
 
 TEST(GltfExport, UnwritablePathFailsWithAReason) {
-  SimpleScene scene(SceneKind::Hang, 4, Attachment::Corners, CapeSettings());
+  SimpleScene scene(SceneKind::Hang, 4, PinLayout::Corners, CapeSettings());
   GltfRecorder recorder(1);
   std::string error;
   EXPECT_FALSE(recorder.write("/nonexistent/folder/x.glb", error));  // nothing recorded yet
@@ -182,7 +182,7 @@ TEST(GltfExport, UnwritablePathFailsWithAReason) {
 }
 
 TEST(Renderer, CapePixelsAreWhereItsVerticesProject) {
-  SimpleScene scene(SceneKind::Walk, 12, Attachment::Corners, CapeSettings());
+  SimpleScene scene(SceneKind::Walk, 12, PinLayout::Corners, CapeSettings());
   for (int f = 0; f < 40; ++f) scene.advanceFrame();
   const int w = 320, h = 200;
   Renderer renderer(w, h, 1);
@@ -240,7 +240,7 @@ TEST(Renderer, CapePixelsAreWhereItsVerticesProject) {
 }
 
 TEST(RunRenderer, FramesHaveTheRequestedSizeAndAreNotBlank) {
-  SimpleScene scene(SceneKind::Walk, 10, Attachment::Corners, CapeSettings());
+  SimpleScene scene(SceneKind::Walk, 10, PinLayout::Corners, CapeSettings());
   const fs::path dir = freshDir("render");
   RunRenderer renderer(dir, 1, 256, 144);
   ASSERT_TRUE(renderer.ok()) << renderer.error();
@@ -292,8 +292,8 @@ TEST(RunRenderer, UncreatableFolderFailsWithAReason) {
 
 TEST(RunRenderer, SideBySidePanelsEachShowTheirOwnCape) {
   // Two capes on twin characters (the second handed over as a mesh, as a btSoftBody twin would be).
-  SimpleScene ours(SceneKind::Walk, 10, Attachment::Corners, CapeSettings());
-  SimpleScene twin(SceneKind::Walk, 10, Attachment::Collar, CapeSettings());
+  SimpleScene ours(SceneKind::Walk, 10, PinLayout::Corners, CapeSettings());
+  SimpleScene twin(SceneKind::Walk, 10, PinLayout::Collar, CapeSettings());
   const fs::path dir = freshDir("side_by_side");
   RunRenderer renderer(dir, 2, 320, 120, RunRenderer::Layout::SideBySide);
   ASSERT_TRUE(renderer.ok()) << renderer.error();

@@ -13,7 +13,7 @@ const char* toString(Integrator integrator) {
   return "?";
 }
 
-CapeSettings CapeSettings::seed() {
+CapeSettings CapeSettings::unitySeed() {
   CapeSettings s;
   s.integrator = Integrator::ExplicitSpring;
   // The seed's grid has 1 g particles: symplectic Euler at 0.00875 s is only stable for a few N/m

@@ -14,9 +14,11 @@ const char* toString(SceneKind kind);
 /// Parses "hang", "walk", "sprint-turn", "wind", "crowd"; false if unknown.
 bool parseSceneKind(const std::string& name, SceneKind& kind);
 
-enum class Attachment : int { Corners, Collar };
-const char* toString(Attachment attachment);
-bool parseAttachment(const std::string& name, Attachment& attachment);
+/// Which cape particles are pinned (docs/SCENES.md's attachment): the two top corners, or the whole top row.
+enum class PinLayout : int { Corners, Collar };
+const char* toString(PinLayout layout);
+/// Parses "corners", "collar"; false if unknown.
+bool parsePinLayout(const std::string& name, PinLayout& layout);
 
 /// How the character moves in a scene. Times in s, lengths in m, angles in rad.
 struct MotionDesc {
@@ -79,7 +81,7 @@ struct CapeRig {
   std::vector<Vec3> pinLocalPoints;            ///< in the character frame, m
 };
 /// The canonical N x N cape (0.6 m x 1.0 m, 0.4 kg) with tethers to its attachment particles.
-CapeRig makeCapeRig(int n, Attachment attachment, bool bendSprings = true);
+CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings = true);
 /// The cape's starting placement in the character frame: flat and vertical at z = 0.15 with its top row on
 /// the pins, or for "hang" flat and horizontal reaching from the pins towards +Z.
 Pose capeStartPlacement(SceneKind kind);
@@ -87,7 +89,7 @@ Pose capeStartPlacement(SceneKind kind);
 /// One cape on the simple body, stepped frame by frame: what tests and benchmarks run.
 class SimpleScene {
  public:
-  SimpleScene(SceneKind kind, int n, Attachment attachment, const CapeSettings& settings,
+  SimpleScene(SceneKind kind, int n, PinLayout layout, const CapeSettings& settings,
               const Vec3& offset = Vec3::Zero());
   const Status& status() const { return cape_.status(); }
   /// Advances one frame of dt seconds: moves the body and the pins, then steps the cape.

@@ -83,8 +83,9 @@ struct CapeSettings {
   /// Keep it well under the spacing, or neighbours of the same layer push each other.
   float selfCollisionThickness = 0.0f;
 
-  /// The seed's reference set-up: explicit springs, soft, 4 substeps of 0.00875 s per 0.035 s frame.
-  static CapeSettings seed();
+  /// The Unity seed's explicit solver reproduced: explicit springs, soft, 4 substeps of 0.00875 s per 0.035 s
+  /// frame. (Nothing to do with the wind's random `WindSettings::seed`.)
+  static CapeSettings unitySeed();
 
   Status validate() const;
 };
