@@ -35,19 +35,9 @@ struct SolverResult {
   MetricsRecorder recorder;
 };
 
-/// The per-frame row of a crowd holds the worst of its characters.
-void mergeWorst(FrameMetrics& into, const FrameMetrics& m, bool first) {
-  into.maxStrain = first ? m.maxStrain : std::max(into.maxStrain, m.maxStrain);
-  into.meanStrain = std::max(into.meanStrain, m.meanStrain);
-  into.maxPenetration = std::max(into.maxPenetration, m.maxPenetration);
-  into.selfIntersections = std::max(into.selfIntersections, m.selfIntersections);
-  into.pinError = std::max(into.pinError, m.pinError);
-  into.meanSpeed = std::max(into.meanSpeed, m.meanSpeed);
-  into.blowUp = into.blowUp || m.blowUp;
-}
-
 /// The twins of every character of a scene, in a world of their own: btSoftBody twins in a soft-rigid world,
-/// or deformable twins in Bullet's deformable world. Measured exactly as ours.
+/// or deformable twins in Bullet's deformable world. Measured exactly as ours: the twin's nodes are copied
+/// into particle arrays and go through the same measureFrame.
 class TwinRun {
  public:
   enum class Kind { SoftBody, Deformable };
@@ -84,6 +74,8 @@ class TwinRun {
       }
       bodies_.push_back(body);
       positions_.push_back(Points::Zero(static_cast<Eigen::Index>(body->m_nodes.size()), 3));
+      velocities_.push_back(Points::Zero(static_cast<Eigen::Index>(body->m_nodes.size()), 3));
+      pins_.emplace_back(scene_->pins(k).size());
       counters_.emplace_back();
       protos_.push_back(std::move(proto));
     }
@@ -95,26 +87,24 @@ class TwinRun {
       for (auto& b : softBodies_) scene_->softRigidWorld()->removeSoftBody(b.get());
   }
   double stepFrame(double t) { return scene_->stepFrame(t); }
+  /// Character k's twin measured by the same measureFrame as our capes: its nodes' positions and velocities,
+  /// and its anchors' particles with their attachment points now.
   FrameMetrics measure(int k) {
-    const btSoftBody& body = *bodies_[static_cast<std::size_t>(k)];
-    Points& x = positions_[static_cast<std::size_t>(k)];
-    for (int i = 0; i < body.m_nodes.size(); ++i) x.row(i) = bullet::toVec3(body.m_nodes[i].m_x).transpose();
-    const Fabric& fabric = *scene_->rig().fabric;  // built (or build() failed) with the scene
-    FrameMetrics m;
-    const StrainStats strain = structuralStrain(fabric, x);
-    m.maxStrain = strain.max;
-    m.meanStrain = strain.mean;
-    m.maxPenetration = maxPenetration(x, scene_->bodyColliders(k));
-    m.selfIntersections = counters_[static_cast<std::size_t>(k)].count(fabric, x);
-    for (const PinSpec& p : scene_->pins(k)) {
-      const btVector3 target = p.body->getWorldTransform() * p.localPivot;
-      m.pinError = std::max(m.pinError, static_cast<float>((body.m_nodes[static_cast<int>(p.particle)].m_x - target).length()));
+    const std::size_t c = static_cast<std::size_t>(k);
+    const btSoftBody& body = *bodies_[c];
+    Points& x = positions_[c];
+    Points& v = velocities_[c];
+    for (int i = 0; i < body.m_nodes.size(); ++i) {
+      x.row(i) = bullet::toVec3(body.m_nodes[i].m_x).transpose();
+      v.row(i) = bullet::toVec3(body.m_nodes[i].m_v).transpose();
     }
-    double speed = 0.0;
-    for (int i = 0; i < body.m_nodes.size(); ++i) speed += body.m_nodes[i].m_v.length();
-    m.meanSpeed = static_cast<float>(speed / std::max(1, body.m_nodes.size()));
-    m.blowUp = isBlownUp(x, scene_->torsoCentre(k));
-    return m;
+    const std::vector<PinSpec>& specs = scene_->pins(k);
+    for (std::size_t p = 0; p < specs.size(); ++p) {
+      pins_[c][p].particle = specs[p].particle;
+      pins_[c][p].target = bullet::toVec3(specs[p].body->getWorldTransform() * specs[p].localPivot);
+    }
+    const Fabric& fabric = *scene_->rig().fabric;  // built (or build() failed) with the scene
+    return measureFrame(fabric, x, v, pins_[c], scene_->bodyColliders(k), scene_->torsoCentre(k), &counters_[c]);
   }
   int characterCount() const { return scene_->characterCount(); }
   const Fabric& fabric() const { return *scene_->rig().fabric; }
@@ -128,7 +118,8 @@ class TwinRun {
   std::vector<std::unique_ptr<btSoftBody>> softBodies_;
   std::vector<std::unique_ptr<bullet::DeformableTwin>> deformables_;
   std::vector<btSoftBody*> bodies_;
-  std::vector<Points> positions_;
+  std::vector<Points> positions_, velocities_;
+  std::vector<std::vector<Pin>> pins_;  ///< per character: each anchored node and its attachment point now
   std::vector<SelfIntersectionCounter> counters_;
 };
 
@@ -269,15 +260,22 @@ int main(int argc, char** argv) {
     // Interleaved, so that the machine's noise falls on every solver alike.
     ours->advanceFrame();
     FrameRow a{f, t, ours->lastFrameTimeUs(), ours->lastCapeTimeUs(), {}};
-    for (int k = 0; k < ours->characterCount(); ++k)
-      mergeWorst(a.metrics, measureFrame(ours->cape(k), ours->bodyColliders(k), ours->torsoCentre(k), &counters[static_cast<std::size_t>(k)]), k == 0);
+    // A crowd's row holds the worst of its characters.
+    for (int k = 0; k < ours->characterCount(); ++k) {
+      const FrameMetrics m =
+          measureFrame(ours->cape(k), ours->bodyColliders(k), ours->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
+      a.metrics = k == 0 ? m : worstOf(a.metrics, m);
+    }
     results[0].rows.push_back(a);
     results[0].recorder.add(a.metrics);
     for (int i = 0; i < twinCount; ++i) {
       const double twinFrame = twinRuns[i].stepFrame(t);
       const double bareFrame = bare[i]->stepFrame(t);
       FrameRow b{f, t, twinFrame, std::max(0.0, twinFrame - bareFrame), {}};
-      for (int k = 0; k < twinRuns[i].characterCount(); ++k) mergeWorst(b.metrics, twinRuns[i].measure(k), k == 0);
+      for (int k = 0; k < twinRuns[i].characterCount(); ++k) {
+        const FrameMetrics m = twinRuns[i].measure(k);
+        b.metrics = k == 0 ? m : worstOf(b.metrics, m);
+      }
       SolverResult& r = results[static_cast<std::size_t>(1 + i)];
       r.rows.push_back(b);
       r.recorder.add(b.metrics);

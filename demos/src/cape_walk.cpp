@@ -122,14 +122,7 @@ int main(int argc, char** argv) {
       const std::vector<Collider> colliders = run->bodyColliders(k);
       const FrameMetrics m = measureFrame(run->cape(k), colliders, run->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
       recorders[static_cast<std::size_t>(k)].add(m);
-      // A crowd's row holds the worst of its characters.
-      row.metrics.maxStrain = k == 0 ? m.maxStrain : std::max(row.metrics.maxStrain, m.maxStrain);
-      row.metrics.meanStrain = std::max(row.metrics.meanStrain, m.meanStrain);
-      row.metrics.maxPenetration = std::max(row.metrics.maxPenetration, m.maxPenetration);
-      row.metrics.selfIntersections = std::max(row.metrics.selfIntersections, m.selfIntersections);
-      row.metrics.pinError = std::max(row.metrics.pinError, m.pinError);
-      row.metrics.meanSpeed = std::max(row.metrics.meanSpeed, m.meanSpeed);
-      row.metrics.blowUp = row.metrics.blowUp || m.blowUp;
+      row.metrics = k == 0 ? m : worstOf(row.metrics, m);  // a crowd's row holds the worst of its characters
       writer->capeMesh(f, k, run->cape(k));
       if (gltfRecorder) gltfRecorder->record(k, run->cape(k), colliders);
       if (renderer) renderer->record(k, run->cape(k), colliders);

@@ -31,12 +31,13 @@ float maxPenetration(const Points& x, ColliderSpan colliders) {
   return worst;
 }
 
-float maxPinError(const CapeState& state) {
+float maxPinError(const Points& x, const std::vector<Pin>& pins) {
   float worst = 0.0f;
-  for (const Pin& p : state.pins)
-    worst = std::max(worst, (state.positions.row(p.particle).transpose() - p.target).norm());
+  for (const Pin& p : pins) worst = std::max(worst, (x.row(p.particle).transpose() - p.target).norm());
   return worst;
 }
+
+float maxPinError(const CapeState& state) { return maxPinError(state.positions, state.pins); }
 
 bool isBlownUp(const Points& x, const Vec3& centre, float radius) {
   if (!x.allFinite()) return true;
@@ -174,19 +175,38 @@ int SelfIntersectionCounter::count(const Fabric& fabric, const Points& x) {
   return found;
 }
 
-FrameMetrics measureFrame(const Cape& cape, ColliderSpan bodyColliders, const Vec3& torsoCentre,
+FrameMetrics measureFrame(const Fabric& fabric, const Points& x, const Points& v, const std::vector<Pin>& pins,
+                          ColliderSpan bodyColliders, const Vec3& torsoCentre,
                           SelfIntersectionCounter* selfIntersections) {
   FrameMetrics m;
-  const Points& x = cape.state().positions;
   m.blowUp = isBlownUp(x, torsoCentre);
   if (m.blowUp) return m;
-  const StrainStats s = structuralStrain(cape.fabric(), x);
+  const StrainStats s = structuralStrain(fabric, x);
   m.maxStrain = s.max;
   m.meanStrain = s.mean;
   m.maxPenetration = maxPenetration(x, bodyColliders);
-  m.pinError = maxPinError(cape.state());
-  m.meanSpeed = x.rows() > 0 ? static_cast<float>(cape.state().velocities.rowwise().norm().mean()) : 0.0f;
-  if (selfIntersections) m.selfIntersections = selfIntersections->count(cape.fabric(), x);
+  m.pinError = maxPinError(x, pins);
+  m.meanSpeed = v.rows() > 0 ? static_cast<float>(v.rowwise().norm().mean()) : 0.0f;
+  if (selfIntersections) m.selfIntersections = selfIntersections->count(fabric, x);
+  return m;
+}
+
+FrameMetrics measureFrame(const Cape& cape, ColliderSpan bodyColliders, const Vec3& torsoCentre,
+                          SelfIntersectionCounter* selfIntersections) {
+  const CapeState& state = cape.state();
+  return measureFrame(cape.fabric(), state.positions, state.velocities, state.pins, bodyColliders, torsoCentre,
+                      selfIntersections);
+}
+
+FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b) {
+  FrameMetrics m;
+  m.maxStrain = std::max(a.maxStrain, b.maxStrain);
+  m.meanStrain = std::max(a.meanStrain, b.meanStrain);
+  m.maxPenetration = std::max(a.maxPenetration, b.maxPenetration);
+  m.selfIntersections = std::max(a.selfIntersections, b.selfIntersections);
+  m.pinError = std::max(a.pinError, b.pinError);
+  m.meanSpeed = std::max(a.meanSpeed, b.meanSpeed);
+  m.blowUp = a.blowUp || b.blowUp;
   return m;
 }
 
@@ -206,6 +226,8 @@ RunSummary MetricsRecorder::summary() const {
   std::vector<double> maxStrains;
   maxStrains.reserve(frames_.size());
   double meanSum = 0.0;
+  // Signed: a run whose every spring stayed compressed has a negative max strain.
+  if (!frames_.empty()) r.maxStrain = frames_.front().maxStrain;
   for (const FrameMetrics& f : frames_) {
     r.blowUp = r.blowUp || f.blowUp;
     r.maxStrain = std::max(r.maxStrain, f.maxStrain);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
+#include "cape/scenes/Metrics.h"
 #include "cape/scenes/Scene.h"
 
 #include <BulletSoftBody/btDeformableBodySolver.h>
@@ -145,15 +146,10 @@ inline bool allFinite(const cape::Points& x) {
   return x.allFinite();
 }
 
-/// Largest structural strain (|xi - xj| - L0) / L0 of the cape.
+/// Largest structural strain (|xi - xj| - L0) / L0 of the cape, by the metrics' own structuralStrain: signed,
+/// as docs/SCENES.md defines it (a compressed spring's strain is negative).
 inline float maxStructuralStrain(const cape::Cape& c) {
-  const cape::SpringSet& s = c.fabric().springs(cape::SpringFamily::Structural);
-  float worst = 0.0f;
-  for (std::size_t k = 0; k < s.size(); ++k) {
-    const float len = (c.state().positions.row(s.first[k]) - c.state().positions.row(s.second[k])).norm();
-    worst = std::max(worst, std::abs(len - s.restLength[k]) / s.restLength[k]);
-  }
-  return worst;
+  return cape::structuralStrain(c.fabric(), c.state().positions).max;
 }
 
 }  // namespace capetest

@@ -117,6 +117,63 @@ TEST(Metrics, RecorderSummarisesFrames) {
   EXPECT_FALSE(s.blowUp);
 }
 
+TEST(Metrics, ACompressedRunHasANegativeMaxStrain) {
+  MetricsRecorder rec;
+  for (int i = 1; i <= 3; ++i) {
+    FrameMetrics m;
+    m.maxStrain = -0.01f * static_cast<float>(i);
+    rec.add(m);
+  }
+  EXPECT_FLOAT_EQ(rec.summary().maxStrain, -0.01f);
+}
+
+// Every solver compared goes through one measureFrame: on the arrays of a cape it gives the cape's own
+// figures, and a blown-up frame says only that.
+TEST(Metrics, OneMeasureFrameForEverySolver) {
+  Cape cape(makeGrid(6, 6), CapeSettings(), Pose{Vec3(-0.3f, 1.5f, 0.0f), Quat::Identity()});
+  cape.pin(0, Vec3(-0.3f, 1.5f, 0.0f));
+  cape.pin(5, Vec3(0.3f, 1.5f, 0.0f));
+  const std::vector<Collider> body{Collider::sphere(0.2f, Pose{Vec3(0.0f, 1.0f, 0.05f), Quat::Identity()})};
+  for (int frame = 0; frame < 20; ++frame) cape.step(1.0f / 60.0f, body);
+  SelfIntersectionCounter c1, c2;
+  const FrameMetrics a = measureFrame(cape, body, Vec3(0.0f, 1.0f, 0.0f), &c1);
+  const CapeState& st = cape.state();
+  const FrameMetrics b =
+      measureFrame(cape.fabric(), st.positions, st.velocities, st.pins, body, Vec3(0.0f, 1.0f, 0.0f), &c2);
+  EXPECT_EQ(a.maxStrain, b.maxStrain);
+  EXPECT_EQ(a.meanStrain, b.meanStrain);
+  EXPECT_EQ(a.maxPenetration, b.maxPenetration);
+  EXPECT_EQ(a.selfIntersections, b.selfIntersections);
+  EXPECT_EQ(a.pinError, b.pinError);
+  EXPECT_EQ(a.meanSpeed, b.meanSpeed);
+  EXPECT_GT(a.meanSpeed, 0.0f);
+  EXPECT_FALSE(a.blowUp);
+
+  Points far = st.positions;
+  far(3, 1) = std::nanf("");
+  const FrameMetrics blown = measureFrame(cape.fabric(), far, st.velocities, st.pins, body, Vec3::Zero(), &c2);
+  EXPECT_TRUE(blown.blowUp);
+  EXPECT_EQ(blown.maxStrain, 0.0f);
+  EXPECT_EQ(blown.meanSpeed, 0.0f);
+}
+
+TEST(Metrics, WorstOfTwoFrames) {
+  FrameMetrics a, b;
+  a.maxStrain = -0.02f;
+  a.meanStrain = -0.03f;
+  b.maxStrain = -0.01f;
+  b.meanStrain = -0.04f;
+  a.maxPenetration = 0.002f;
+  b.selfIntersections = 3;
+  b.blowUp = true;
+  const FrameMetrics w = worstOf(a, b);
+  EXPECT_EQ(w.maxStrain, -0.01f);
+  EXPECT_EQ(w.meanStrain, -0.03f);
+  EXPECT_EQ(w.maxPenetration, 0.002f);
+  EXPECT_EQ(w.selfIntersections, 3);
+  EXPECT_TRUE(w.blowUp);
+}
+
 TEST(Metrics, PercentileNearestRank) {
   EXPECT_EQ(percentile({}, 50), 0.0);
   EXPECT_EQ(percentile({3, 1, 2}, 50), 2.0);
