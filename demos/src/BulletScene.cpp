@@ -1,6 +1,7 @@
 #include "BulletScene.h"
 
 #include "cape/bullet/Convert.h"
+#include "cape/scenes/BulletSimpleBody.h"
 
 #include <algorithm>
 #include <chrono>
@@ -34,25 +35,17 @@ Vec3 crowdOffset(int k, int count) {
 }  // namespace
 
 /// One character: its bodies (from the character library, or the simple body's five), and its cape's pins.
+/// Each removes its bodies from the world when destroyed.
 struct BulletScene::Character {
   // URDF character.
   std::unique_ptr<character::Character> urdf;
   int torsoLink = 0;
   // The simple body.
-  std::unique_ptr<SimpleBody> simple;
-  std::vector<std::unique_ptr<btCollisionShape>> shapes;
-  std::vector<std::unique_ptr<btDefaultMotionState>> states;
-  std::vector<std::unique_ptr<btRigidBody>> bodies;
-  btDynamicsWorld* world = nullptr;
+  std::unique_ptr<BulletSimpleBody> simple;
 
   Vec3 offset = Vec3::Zero();
   Pose placement;
   std::vector<PinSpec> pins;
-
-  ~Character() {
-    // Bullet's rule: what we added, we remove before it is deleted.
-    for (auto& b : bodies) world->removeRigidBody(b.get());
-  }
 };
 
 std::unique_ptr<BulletScene> BulletScene::create(const RunOptions& options, std::string& error, WorldKind kind) {
@@ -145,7 +138,6 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
 
   for (int k = 0; k < count; ++k) {
     auto c = std::make_unique<Character>();
-    c->world = world_.get();
     c->offset = crowdOffset(k, count);
     Vec3 shift = c->offset;  // moves SCENARIOS.md's pin line onto this character's
     std::vector<std::pair<float, btRigidBody*>> anchors;  // attachment bodies by their x at rest
@@ -178,35 +170,14 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
       }
       shift = centre + kPinLineFromShoulders - kPinLineCentre;
     } else {
-      c->simple = std::make_unique<SimpleBody>(c->offset);
-      c->simple->moveTo(motionAt(motion_, 0.0), true);
-      const std::vector<Collider>& colliders = c->simple->colliders();
-      for (int i = 0; i < SimpleBody::kGround; ++i) {
-        const Collider& col = colliders[static_cast<std::size_t>(i)];
-        std::unique_ptr<btCollisionShape> shape;
-        switch (col.shape) {
-          case ColliderShape::Box: shape = std::make_unique<btBoxShape>(toBt(col.halfExtents)); break;
-          case ColliderShape::Sphere: shape = std::make_unique<btSphereShape>(btScalar(col.radius)); break;
-          case ColliderShape::Capsule:
-            shape = std::make_unique<btCapsuleShape>(btScalar(col.radius), btScalar(2.0f * col.halfHeight));
-            break;
-          default: break;
-        }
-        auto state = std::make_unique<btDefaultMotionState>(toBt(col.current));
-        btRigidBody::btRigidBodyConstructionInfo info(btScalar(0), state.get(), shape.get());
-        auto body = std::make_unique<btRigidBody>(info);
-        body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
-        body->setActivationState(DISABLE_DEACTIVATION);
-        world_->addRigidBody(body.get());
-        c->shapes.push_back(std::move(shape));
-        c->states.push_back(std::move(state));
-        c->bodies.push_back(std::move(body));
-      }
+      // Torso, shoulders and legs as kinematic bodies, at the scene's starting pose (the world's ground is
+      // shared by every character).
+      c->simple = std::make_unique<BulletSimpleBody>(*world_, c->offset, motionAt(motion_, 0.0));
       if (o.pinLayout == PinLayout::Collar) {
-        anchors.emplace_back(0.0f, c->bodies[SimpleBody::kTorso].get());
+        anchors.emplace_back(0.0f, c->simple->rigidBody(SimpleBody::kTorso));
       } else {
-        anchors.emplace_back(-1.0f, c->bodies[SimpleBody::kLeftShoulder].get());
-        anchors.emplace_back(1.0f, c->bodies[SimpleBody::kRightShoulder].get());
+        anchors.emplace_back(-1.0f, c->simple->rigidBody(SimpleBody::kLeftShoulder));
+        anchors.emplace_back(1.0f, c->simple->rigidBody(SimpleBody::kRightShoulder));
       }
     }
     std::sort(anchors.begin(), anchors.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -236,10 +207,7 @@ void BulletScene::poseAt(double t) {
       c->urdf->advanceTo(t);
       continue;
     }
-    c->simple->moveTo(motionAt(motion_, t));
-    // Kinematic bodies follow their motion states; Bullet derives their velocities in stepSimulation.
-    for (std::size_t i = 0; i < c->bodies.size(); ++i)
-      c->states[i]->setWorldTransform(toBt(c->simple->colliders()[i].current));
+    c->simple->moveTo(motionAt(motion_, t));  // the colliders, and the bodies' motion states
   }
 }
 
@@ -253,7 +221,7 @@ double BulletScene::stepFrame(double t) {
 std::vector<Collider> BulletScene::bodyColliders(int k) const {
   const Character& c = *characters_[static_cast<std::size_t>(k)];
   if (c.simple) {
-    const ColliderSpan s = c.simple->bodyColliders();
+    const ColliderSpan s = c.simple->body().bodyColliders();
     return std::vector<Collider>(s.begin(), s.end());
   }
   std::vector<Collider> out;
@@ -275,7 +243,7 @@ std::vector<Collider> BulletScene::bodyColliders(int k) const {
 
 Vec3 BulletScene::torsoCentre(int k) const {
   const Character& c = *characters_[static_cast<std::size_t>(k)];
-  if (c.simple) return c.simple->torsoCentre();
+  if (c.simple) return c.simple->body().torsoCentre();
   return c.urdf->skeleton().linkPose(c.torsoLink).translation().cast<float>();
 }
 
