@@ -12,7 +12,7 @@
 
 #include "cape/bullet/CapeAction.h"
 #include "cape/bullet/Convert.h"
-#include "cape/bullet/SoftBodyTwin.h"
+#include "cape/compare/SoftBodyTwin.h"
 
 #include <BulletSoftBody/btSoftBody.h>
 #include <CLI/CLI.hpp>
@@ -42,8 +42,8 @@ class TwinRun {
  public:
   enum class Kind { SoftBody, Deformable };
 
-  bool build(const RunOptions& o, Kind kind, const bullet::SoftBodyTwinSettings& soft,
-             const bullet::DeformableTwinSettings& deformable, std::string& error) {
+  bool build(const RunOptions& o, Kind kind, const compare::SoftBodyTwinSettings& soft,
+             const compare::DeformableTwinSettings& deformable, std::string& error) {
     scene_ = BulletScene::create(o, error, kind == Kind::Deformable ? WorldKind::Deformable : WorldKind::SoftRigid);
     if (!scene_) return false;
     const CapeSettings settings = settingsForScene(o.scene, o.settings);
@@ -53,7 +53,7 @@ class TwinRun {
       for (const PinSpec& p : scene_->pins(k)) proto->attach(p.particle, p.body, p.localPivot);
       btSoftBody* body = nullptr;
       if (kind == Kind::SoftBody) {
-        std::unique_ptr<btSoftBody> made = bullet::makeSoftBodyTwin(*scene_->softRigidWorld(), *proto, soft);
+        std::unique_ptr<btSoftBody> made = compare::makeSoftBodyTwin(*scene_->softRigidWorld(), *proto, soft);
         if (made && settings.wind.model != WindSettings::Model::None) {
           // Bullet's own aerodynamics, two-sided, in the mean wind (btSoftBody has no gust field).
           made->m_cfg.aeromodel = btSoftBody::eAeroModel::V_TwoSided;
@@ -64,7 +64,7 @@ class TwinRun {
         body = made.get();
         if (made) softBodies_.push_back(std::move(made));
       } else {
-        std::unique_ptr<bullet::DeformableTwin> made = bullet::makeDeformableTwin(*scene_->deformableWorld(), *proto, deformable);
+        std::unique_ptr<compare::DeformableTwin> made = compare::makeDeformableTwin(*scene_->deformableWorld(), *proto, deformable);
         body = made ? &made->body() : nullptr;
         if (made) deformables_.push_back(std::move(made));
       }
@@ -116,14 +116,14 @@ class TwinRun {
   std::unique_ptr<BulletScene> scene_;
   std::vector<std::unique_ptr<bullet::CapeAction>> protos_;
   std::vector<std::unique_ptr<btSoftBody>> softBodies_;
-  std::vector<std::unique_ptr<bullet::DeformableTwin>> deformables_;
+  std::vector<std::unique_ptr<compare::DeformableTwin>> deformables_;
   std::vector<btSoftBody*> bodies_;
   std::vector<Points> positions_, velocities_;
   std::vector<std::vector<Pin>> pins_;  ///< per character: each anchored node and its attachment point now
   std::vector<SelfIntersectionCounter> counters_;
 };
 
-json twinSettingsJson(const bullet::SoftBodyTwinSettings& t) {
+json twinSettingsJson(const compare::SoftBodyTwinSettings& t) {
   return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") + (t.bendLinks ? "bend" : "")},
           {"piterations", t.positionIterations}, {"viterations", t.velocityIterations},
           {"diterations", t.driftIterations}, {"kLST", t.linearStiffness}, {"kDP", t.damping},
@@ -131,7 +131,7 @@ json twinSettingsJson(const bullet::SoftBodyTwinSettings& t) {
           {"margin_m", t.margin}, {"collisions", "SDF_RS"}};
 }
 
-json deformableSettingsJson(const bullet::DeformableTwinSettings& t) {
+json deformableSettingsJson(const compare::DeformableTwinSettings& t) {
   return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") + (t.bendLinks ? "bend" : "")},
           {"world", "btDeformableMultiBodyDynamicsWorld, explicit"},
           {"elastic_stiffness_N_per_m", t.elasticStiffness}, {"damping_stiffness_Ns_per_m", t.dampingStiffness},
@@ -177,7 +177,7 @@ int main(int argc, char** argv) {
   // soften btSoftBody's stretch resistance and are left out), friction, thickness and air drag as ours
   // (btSoftBody damps by (1 - kDP) per step, ours by 1 / (1 + c h)); its stiffest material, and as many
   // position iterations as asked for (10 by default, the figure the issue quotes).
-  bullet::SoftBodyTwinSettings twin;
+  compare::SoftBodyTwinSettings twin;
   const double h = 1.0 / 240.0;
   const double c = o.settings.damping;
   twin.positionIterations = iterations;
@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
   // friction and thickness, explicit steps. Its stiffness cannot be ours: with the 20 x 20 cape's 1 g nodes
   // at 1/240 s the deformable world blows up from 100 N/m (measured; ours are 20000 N/m), so the default is
   // 50 N/m.
-  bullet::DeformableTwinSettings deformable;
+  compare::DeformableTwinSettings deformable;
   deformable.elasticStiffness = btScalar(deformableStiffness);
   deformable.friction = btScalar(o.settings.friction);
   deformable.margin = btScalar(o.settings.collisionThickness);

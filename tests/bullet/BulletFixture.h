@@ -1,5 +1,5 @@
-// Shared set-up for the adapter's tests: a real Bullet world (discrete, or soft-rigid for the twin), bodies
-// made the usual way, and the canonical cape.
+// Shared set-up for the adapter's tests and the comparison's (tests/compare): a real Bullet world (discrete,
+// or soft-rigid or deformable for the twins), bodies made the usual way, and the canonical cape.
 #pragma once
 
 #include "cape/bullet/CapeAction.h"

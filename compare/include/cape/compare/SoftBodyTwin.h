@@ -1,8 +1,9 @@
 // The btSoftBody twin of a cape: Bullet's own soft body on the same grid (nodes where the cape's particles
 // are now, the same masses), with a link for every spring of the chosen families, anchored to the same
-// bodies at the same body-local pivots, colliding with the same rigid bodies. For the comparison demo and
-// tests. Anchored bodies should be kinematic: btSoftBody anchors pull on dynamic bodies, the cape's pins
-// do not.
+// bodies at the same body-local pivots, colliding with the same rigid bodies; and its twin in Bullet's
+// deformable world. The comparison's own tools (library cape::compare_twins, used by cape_compare and its
+// tests), not part of the Bullet adapter. Anchored bodies should be kinematic: btSoftBody anchors pull on
+// dynamic bodies, the cape's pins do not.
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
@@ -15,7 +16,7 @@
 #include <memory>
 #include <vector>
 
-namespace cape::bullet {
+namespace cape::compare {
 
 struct SoftBodyTwinSettings {
   bool structuralLinks = true;  ///< Rows and columns.
@@ -43,7 +44,7 @@ struct SoftBodyTwinSettings {
 /// The caller owns it: world.removeSoftBody(twin.get()) before it is destroyed. Nodes are the cape's
 /// particles in order; links are appended family by family in the fabric's spring order; triangles are the
 /// fabric's (for drawing and aerodynamics).
-std::unique_ptr<btSoftBody> makeSoftBodyTwin(btSoftRigidDynamicsWorld& world, const CapeAction& cape,
+std::unique_ptr<btSoftBody> makeSoftBodyTwin(btSoftRigidDynamicsWorld& world, const bullet::CapeAction& cape,
                                              const SoftBodyTwinSettings& settings = SoftBodyTwinSettings());
 
 /// The twin for Bullet's deformable world (btDeformableMultiBodyDynamicsWorld, Xuchen Han's solver of
@@ -88,7 +89,8 @@ class DeformableTwin {
 
 /// Builds the deformable twin of `cape` from its current state and attachments and adds it to `world`;
 /// nullptr if the cape is not ok. Anchors are Bullet's deformable anchors to the attachment bodies.
-std::unique_ptr<DeformableTwin> makeDeformableTwin(btDeformableMultiBodyDynamicsWorld& world, const CapeAction& cape,
+std::unique_ptr<DeformableTwin> makeDeformableTwin(btDeformableMultiBodyDynamicsWorld& world,
+                                                   const bullet::CapeAction& cape,
                                                    const DeformableTwinSettings& settings = DeformableTwinSettings());
 
-}  // namespace cape::bullet
+}  // namespace cape::compare

@@ -1,4 +1,4 @@
-#include "cape/bullet/SoftBodyTwin.h"
+#include "cape/compare/SoftBodyTwin.h"
 
 #include "cape/bullet/Convert.h"
 
@@ -7,7 +7,10 @@
 
 #include <vector>
 
-namespace cape::bullet {
+namespace cape::compare {
+
+using bullet::Attachment;
+using bullet::CapeAction;
 
 namespace {
 
@@ -114,4 +117,4 @@ std::unique_ptr<DeformableTwin> makeDeformableTwin(btDeformableMultiBodyDynamics
   return std::make_unique<DeformableTwin>(world, std::move(body), std::move(forces));
 }
 
-}  // namespace cape::bullet
+}  // namespace cape::compare
