@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -549,5 +550,165 @@ TEST(CapeAction, WalkOnTheSimpleBodyPinnedToTheShoulders) {
   EXPECT_LT(worstDepth, 1e-3);
   EXPECT_LT(worstStrain, 0.1f);
   RecordProperty("max_strain", std::to_string(worstStrain));
+  w.world->removeAction(&action);
+}
+
+// --- Discovery through the broadphase, bodies leaving the world (issue 12) --------------------------------
+
+TEST(CapeAction, DiscoveryFindsTheNearBoxAndIgnoresTheFarTheFilteredAndTheGhost) {
+  World w;
+  btRigidBody* near = w.addStatic(new btBoxShape(btVector3(0.4f, 0.05f, 0.6f)),
+                                  btTransform(btQuaternion::getIdentity(), btVector3(0, 0, 0)));
+  w.addStatic(new btBoxShape(btVector3(0.4f, 0.05f, 0.6f)),
+              btTransform(btQuaternion::getIdentity(), btVector3(0, 0.2f, 30)));
+  // In the cape's way, but the cape's mask leaves the first out and the second's mask leaves the cape out.
+  const int kNotCape = 64;
+  w.addStatic(new btBoxShape(btVector3(0.1f, 0.1f, 0.1f)),
+              btTransform(btQuaternion::getIdentity(), btVector3(0.15f, 0.25f, 0)), kNotCape,
+              btBroadphaseProxy::AllFilter);
+  w.addStatic(new btBoxShape(btVector3(0.1f, 0.1f, 0.1f)),
+              btTransform(btQuaternion::getIdentity(), btVector3(-0.15f, 0.25f, 0)),
+              btBroadphaseProxy::StaticFilter,
+              btBroadphaseProxy::AllFilter & ~btBroadphaseProxy::DefaultFilter);
+  btRigidBody* ghost = w.addStatic(new btBoxShape(btVector3(0.1f, 0.1f, 0.1f)),
+                                   btTransform(btQuaternion::getIdentity(), btVector3(0, 0.25f, 0.3f)));
+  ghost->setCollisionFlags(ghost->getCollisionFlags() | btCollisionObject::CF_NO_CONTACT_RESPONSE);
+  cape::bullet::CapeActionSettings s;
+  s.collisionMask = btBroadphaseProxy::AllFilter & ~kNotCape;
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.5)), s);
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 60; ++frame) {
+    w.world->stepSimulation(kFrame, 8, kFixed);
+    for (const btCollisionObject* o : action.activeObjects()) EXPECT_EQ(o, near) << "frame " << frame;
+  }
+  ASSERT_EQ(action.activeObjects().size(), 1u);
+  EXPECT_EQ(action.activeObjects()[0], near);
+  // It lies on the near box (top at 0.05), through the filtered boxes and the ghost (tops at 0.35).
+  EXPECT_GT(action.position(10 * 20 + 10).y(), 0.05f);
+  EXPECT_LT(action.position(10 * 20 + 10).y(), 0.1f);
+  w.world->removeAction(&action);
+}
+
+TEST(CapeAction, ObjectsDiscoveredInOneStepFollowTheWorldArrayOrderNotTheBroadphaseTrees) {
+  // Fourteen objects scattered around the cape (sizes and places from a fixed sequence), all within the
+  // discovery margin at the first step: the broadphase reports them in its trees' order, the colliders come
+  // in the world's array order.
+  World w;
+  std::vector<const btCollisionObject*> added;
+  unsigned seed = 12345u;
+  const auto next = [&]() {
+    seed = seed * 1664525u + 1013904223u;
+    return float(seed >> 8) / float(1 << 24);
+  };
+  for (int i = 0; i < 14; ++i) {
+    const btVector3 at(2.0f * next() - 1.0f, -0.6f + next(), 2.0f * next() - 1.0f);
+    btCollisionShape* shape =
+        i % 2 ? static_cast<btCollisionShape*>(new btSphereShape(0.05f + 0.1f * next()))
+              : new btBoxShape(btVector3(0.1f + 0.1f * next(), 0.05f, 0.1f + 0.1f * next()));
+    added.push_back(w.addStatic(shape, btTransform(btQuaternion(btVector3(0, 1, 0), next()), at)));
+  }
+  cape::bullet::CapeActionSettings s;
+  s.discoveryMargin = 3.0f;
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.7)), s);
+  w.world->addAction(&action);
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_EQ(action.activeObjects(), added);
+  // Two leave the world from the middle of the array (the last objects are swapped into their slots) and
+  // one comes back (at the end of the array): the others keep their order, the returning one comes last.
+  w.world->removeRigidBody(w.bodies[2].get());
+  w.world->removeRigidBody(w.bodies[7].get());
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  std::vector<const btCollisionObject*> expected;
+  for (std::size_t i = 0; i < added.size(); ++i)
+    if (i != 2 && i != 7) expected.push_back(added[i]);
+  EXPECT_EQ(action.activeObjects(), expected);
+  w.world->addRigidBody(w.bodies[2].get());
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  expected.push_back(added[2]);
+  EXPECT_EQ(action.activeObjects(), expected);
+  w.world->removeAction(&action);
+}
+
+TEST(CapeAction, BodiesRemovedFromTheMiddleOfTheArrayAreDroppedAndTheCapeKeepsItsOtherColliders) {
+  // The world's array: [far0, holder, left, right, ground, far1, far2, far3]. The cape hangs from the holder
+  // over the two spheres and the ground; the far boxes (20 m away) are never followed.
+  World w;
+  const auto farBox = [&](btScalar x) {
+    return w.addStatic(new btBoxShape(btVector3(0.1f, 0.1f, 0.1f)),
+                       btTransform(btQuaternion::getIdentity(), btVector3(x, 0, 0)));
+  };
+  btRigidBody* far0 = farBox(20);
+  btRigidBody* holder = w.addKinematic(new btSphereShape(0.05f),
+                                       btTransform(btQuaternion::getIdentity(), btVector3(0, 0.6f, 0.6f)));
+  btRigidBody* left = w.addStatic(new btSphereShape(0.1f),
+                                  btTransform(btQuaternion::getIdentity(), btVector3(-0.15f, 0, 0.1f)));
+  btRigidBody* right = w.addStatic(new btSphereShape(0.1f),
+                                   btTransform(btQuaternion::getIdentity(), btVector3(0.15f, 0, 0.1f)));
+  btRigidBody* ground = w.addStatic(new btBoxShape(btVector3(1.5f, 0.05f, 1.5f)),
+                                    btTransform(btQuaternion::getIdentity(), btVector3(0, -0.3f, 0)));
+  btRigidBody* far1 = farBox(21);
+  btRigidBody* far2 = farBox(22);
+  btRigidBody* far3 = farBox(23);
+  const btCollisionObjectArray& array = w.world->getCollisionObjectArray();
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.5)));
+  std::vector<std::string> warnings;
+  action.setWarningHandler([&](const std::string& m) { warnings.push_back(m); });
+  ASSERT_EQ(action.attachRow(0, holder), 20u);
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 40; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  const std::vector<const btCollisionObject*> before = action.activeObjects();
+  for (const btCollisionObject* o : {left, right, ground})
+    ASSERT_NE(std::find(before.begin(), before.end(), o), before.end()) << "the cape hangs over the spheres";
+  for (const btCollisionObject* o : {far0, far1, far2, far3})
+    EXPECT_EQ(std::find(before.begin(), before.end(), o), before.end());
+  EXPECT_TRUE(warnings.empty());
+
+  // Between two steps the attachment body leaves from slot 1 and the left sphere from slot 2; Bullet swaps
+  // the last boxes into their slots, so every followed object's old index is still inside the array. Both
+  // are deleted.
+  w.world->removeRigidBody(holder);
+  w.world->removeRigidBody(left);
+  ASSERT_EQ(array.size(), 6);
+  ASSERT_EQ(array[1], far3);
+  ASSERT_EQ(array[2], far2);
+  for (auto& body : w.bodies)
+    if (body.get() == holder || body.get() == left) body.reset();
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_TRUE(action.attachments().empty());
+  EXPECT_TRUE(action.cape().state().pins.empty());
+  EXPECT_GT(action.cape().state().inverseMasses.minCoeff(), 0.0f);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("20 cape particle(s)"), std::string::npos) << warnings[0];
+  std::vector<const btCollisionObject*> expected;
+  for (const btCollisionObject* o : before)
+    if (o != holder && o != left) expected.push_back(o);
+  EXPECT_EQ(action.activeObjects(), expected) << "the remaining colliders, in their order";
+
+  // Boxes nobody follows leave: from the end, then from slot 0, which moves the ground (now last) there.
+  w.world->removeRigidBody(far1);
+  w.world->removeRigidBody(far0);
+  ASSERT_EQ(array[0], ground);
+  double worstDepth = 0.0;
+  int touching[2] = {0, 0};  // frames with a particle within 2 cm of the ground, of the right sphere
+  const btRigidBody* kept[2] = {ground, right};
+  for (int frame = 0; frame < 90; ++frame) {
+    w.world->stepSimulation(kFrame, 8, kFixed);
+    for (int k = 0; k < 2; ++k) {
+      btScalar nearest = BT_LARGE_FLOAT;
+      for (std::size_t i = 0; i < action.particleCount(); ++i)
+        nearest = std::min(nearest, cape::bullet::shapeSignedDistance(kept[k]->getCollisionShape(),
+                                                                      kept[k]->getWorldTransform(),
+                                                                      action.position(std::uint32_t(i))));
+      worstDepth = std::max(worstDepth, double(-nearest));
+      touching[k] += nearest < btScalar(0.02) ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(action.activeObjects(), expected);
+  ASSERT_TRUE(allFinite(action.positions()));
+  EXPECT_GT(touching[0], 0) << "the released cape falls onto the ground";
+  EXPECT_GT(touching[1], 0) << "and meets the right sphere";
+  EXPECT_LT(worstDepth, 1e-3) << "the cape still collides with the ground and the right sphere";
+  EXPECT_GT(action.positions().col(1).minCoeff(), -0.25f - 1e-3f) << "it lies on the ground";
   w.world->removeAction(&action);
 }

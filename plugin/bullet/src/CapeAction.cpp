@@ -1,11 +1,14 @@
 // CapeAction: the cape's side of each internal step of a Bullet world. Order of one update:
-//   1. prepare (reads the world): drop bodies that left the world, discover colliders, advance every
-//      followed body's pose by one internal step, teleport and inertia, pin targets, core colliders;
+//   1. prepare (reads the world): drop bodies that left the world (an index check per followed object, a
+//      scan of the world's array only when one fails), discover colliders (the broadphase's aabbTest),
+//      advance every followed body's pose by one internal step, teleport and inertia, pin targets, core
+//      colliders;
 //   2. advance (this cape only): Cape::step, then the post-pass for GJK convex shapes and triangle meshes.
 #include "cape/bullet/CapeAction.h"
 
 #include "cape/bullet/Convert.h"
 
+#include <BulletCollision/BroadphaseCollision/btBroadphaseInterface.h>
 #include <BulletCollision/CollisionDispatch/btCollisionWorld.h>
 #include <BulletCollision/CollisionShapes/btConcaveShape.h>
 #include <BulletCollision/CollisionShapes/btTriangleCallback.h>
@@ -54,6 +57,34 @@ struct TriangleCollector : btTriangleCallback {
   }
 };
 
+/// Discovery's broadphase query: keeps every proxy the rule accepts, with its object's index in the world's
+/// collision object array. Bullet calls process() only for proxies in its broadphase, i.e. for objects in
+/// the world, so reading the object here is safe.
+struct DiscoveryCallback : btBroadphaseAabbCallback {
+  const btCollisionObjectArray* objects = nullptr;
+  btVector3 lo, hi;
+  int group = 0, mask = 0;
+  std::vector<std::pair<int, const btCollisionObject*>>* found = nullptr;
+
+  bool process(const btBroadphaseProxy* proxy) override {
+    const auto* o = static_cast<const btCollisionObject*>(proxy->m_clientObject);
+    // Only the world's own proxies (an object whose handle this is), as the scan of the world's array had.
+    if (o == nullptr || o->getBroadphaseHandle() != proxy || !o->hasContactResponse()) return true;
+    if (o->getInternalType() == btCollisionObject::CO_SOFT_BODY) return true;
+    const bool accepted =
+        (proxy->m_collisionFilterGroup & mask) != 0 && (group & proxy->m_collisionFilterMask) != 0;
+    // The trees hold grown volumes: the proxy's own AABB decides, as before.
+    if (!accepted || !TestAabbAgainstAabb2(lo, hi, proxy->m_aabbMin, proxy->m_aabbMax)) return true;
+    int index = o->getWorldArrayIndex();
+    if (index < 0 || index >= objects->size() || (*objects)[index] != o) {
+      // Bullet keeps the index (btCollisionWorld add/remove); should it not, find the object's slot.
+      index = objects->findLinearSearch(const_cast<btCollisionObject*>(o));
+      if (index >= objects->size()) return true;  // not in this world's array
+    }
+    found->emplace_back(index, o);
+    return true;
+  }
+};
 
 }  // namespace
 
@@ -106,6 +137,7 @@ CapeAction::Tracked& CapeAction::track(const btCollisionObject* object) {
   t.object = object;
   const btTransform& w = object->getWorldTransform();
   t.lastSeen = t.segmentStart = t.segmentEnd = t.stepStart = t.stepEnd = w;
+  t.worldIndex = object->getWorldArrayIndex();  // a hint for dropMissing (checked before it is trusted)
   trackedIndex_[object] = tracked_.size();
   tracked_.push_back(std::move(t));
   return tracked_.back();
@@ -207,13 +239,22 @@ void CapeAction::updateAction(btCollisionWorld* world, btScalar dt) {
 }
 
 void CapeAction::dropMissing(btCollisionWorld* world) {
-  // Pointers only: a body removed from the world may already be deleted. One pass over the world's array
-  // marks the followed objects still in it (a lookup in the small map of followed objects, no allocation).
-  for (Tracked& t : tracked_) t.present = false;
+  // Pointers only: a body removed from the world may already be deleted. Each followed object should still
+  // be where it was last seen in the world's array; if all are, none left the world (O(followed objects)).
   const btCollisionObjectArray& objects = world->getCollisionObjectArray();
+  const auto inPlace = [&](const Tracked& t) {
+    return t.worldIndex >= 0 && t.worldIndex < objects.size() && objects[t.worldIndex] == t.object;
+  };
+  if (std::all_of(tracked_.begin(), tracked_.end(), inPlace)) return;
+  // Something left the world or was moved by Bullet's swap-and-pop removal: one pass over the world's array
+  // marks the followed objects still in it and refreshes their indices (a lookup in the small map of
+  // followed objects, no allocation).
+  for (Tracked& t : tracked_) t.present = false;
   for (int i = 0; i < objects.size(); ++i) {
     auto it = trackedIndex_.find(objects[i]);
-    if (it != trackedIndex_.end()) tracked_[it->second].present = true;
+    if (it == trackedIndex_.end()) continue;
+    tracked_[it->second].present = true;
+    tracked_[it->second].worldIndex = i;
   }
   bool dropped = false;
   for (const Tracked& t : tracked_) {
@@ -245,18 +286,26 @@ void CapeAction::discover(btCollisionWorld* world) {
   // The cape's bounds at the start of the step, grown by its thickness and the discovery margin.
   const Points& x = positions();
   const btScalar grow = btScalar(cape_.settings().collisionThickness) + settings_.discoveryMargin;
-  const btVector3 lo = toBt(Vec3(x.colwise().minCoeff().transpose())) - btVector3(grow, grow, grow);
-  const btVector3 hi = toBt(Vec3(x.colwise().maxCoeff().transpose())) + btVector3(grow, grow, grow);
-  const btCollisionObjectArray& objects = world->getCollisionObjectArray();
-  for (int i = 0; i < objects.size(); ++i) {
-    const btCollisionObject* o = objects[i];
-    const btBroadphaseProxy* proxy = o->getBroadphaseHandle();
-    if (proxy == nullptr || !o->hasContactResponse()) continue;
-    if (o->getInternalType() == btCollisionObject::CO_SOFT_BODY) continue;
-    const bool accepted = (proxy->m_collisionFilterGroup & settings_.collisionMask) != 0 &&
-                          (settings_.collisionGroup & proxy->m_collisionFilterMask) != 0;
-    if (!accepted || !TestAabbAgainstAabb2(lo, hi, proxy->m_aabbMin, proxy->m_aabbMax)) continue;
-    track(o).discovered = true;
+  DiscoveryCallback query;
+  query.objects = &world->getCollisionObjectArray();
+  query.lo = toBt(Vec3(x.colwise().minCoeff().transpose())) - btVector3(grow, grow, grow);
+  query.hi = toBt(Vec3(x.colwise().maxCoeff().transpose())) + btVector3(grow, grow, grow);
+  query.group = settings_.collisionGroup;
+  query.mask = settings_.collisionMask;
+  found_.clear();
+  query.found = &found_;
+  world->getBroadphase()->aabbTest(query.lo, query.hi, query);
+  // The broadphase reports in its trees' order: the world's array order makes the objects first seen in
+  // this step follow (and collide) in the same order whatever the trees look like.
+  std::sort(found_.begin(), found_.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  found_.erase(std::unique(found_.begin(), found_.end(),
+                           [](const auto& a, const auto& b) { return a.first == b.first; }),
+               found_.end());
+  for (const auto& [index, object] : found_) {
+    Tracked& t = track(object);
+    t.discovered = true;
+    t.worldIndex = index;
   }
 }
 

@@ -3,12 +3,25 @@
 // converts what it needs (pin targets from the bodies it is attached to, colliders from the bodies it
 // touches) and delegates the step to cape::Cape.
 //
+// Discovery goes through the world's broadphase (btBroadphaseInterface::aabbTest over the cape's grown
+// bounds; btDbvtBroadphase answers from its AABB trees), so its cost follows the objects near the cape, not
+// the size of the world. What it finds is ordered by the objects' indices in the world's collision object
+// array (read while Bullet reports them, so while they are certainly in the world), never by the
+// broadphase's tree order or by addresses: the followed objects, and so the colliders, keep the order of
+// first sight, ties in one step broken by array index.
+//
 // Ownership (Bullet's rule): the user owns the bodies, removes them from the world before deleting them,
 // and removes the action from the world before destroying it. The action never dereferences a body that
-// is no longer in the world: at the start of every update it compares the pointers it holds against the
-// world's collision object array (pointers only) and drops every attachment and collider whose body is
-// gone, releasing its particles, with one warning per body. So removing a body (and deleting it) between
-// two stepSimulation calls is safe; calling detach(body) first is the tidy way and warns about nothing.
+// is no longer in the world. It remembers, for every object it follows (attachment bodies and colliders),
+// the index in the world's collision object array where it last saw it; at the start of every update it
+// checks `index < size && array[index] == pointer` for each (pointers only). If every check holds, nothing
+// left the world: O(followed objects) per step, whatever the size of the world. If one fails (an object
+// left the world, or btCollisionWorld::removeCollisionObject's swap-and-pop moved a followed object into
+// another slot), it scans the array once, pointers only, refreshing every index and dropping every
+// attachment and collider whose body is gone, releasing its particles, with one warning per body. So
+// removing a body (and deleting it) between two stepSimulation calls is safe; calling detach(body) first
+// is the tidy way and warns about nothing. (As with any pointer comparison, a new object that reuses a
+// deleted body's address is taken for it: detach(body) before deleting a body that another may replace.)
 #pragma once
 
 #include "cape/bullet/ShapeColliders.h"
@@ -23,6 +36,7 @@
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 class btCollisionWorld;
@@ -35,10 +49,10 @@ using WarningHandler = std::function<void(const std::string&)>;
 
 /// Per-action parameters, plain data with units.
 struct CapeActionSettings {
-  /// Find colliders automatically: every collision object whose broadphase AABB overlaps the cape's
-  /// bounds (grown by discoveryMargin) and whose filter accepts the cape's group and mask (Bullet's rule:
-  /// (object.group & cape.mask) != 0 and (cape.group & object.mask) != 0). Objects without contact
-  /// response (CF_NO_CONTACT_RESPONSE: triggers, ghosts) and soft bodies are skipped.
+  /// Find colliders automatically (through the world's broadphase): every collision object whose broadphase
+  /// AABB overlaps the cape's bounds (grown by discoveryMargin) and whose filter accepts the cape's group
+  /// and mask (Bullet's rule: (object.group & cape.mask) != 0 and (cape.group & object.mask) != 0). Objects
+  /// without contact response (CF_NO_CONTACT_RESPONSE: triggers, ghosts) and soft bodies are skipped.
   bool discoverColliders = true;
   int collisionGroup = btBroadphaseProxy::DefaultFilter;
   int collisionMask = btBroadphaseProxy::AllFilter;
@@ -165,7 +179,9 @@ class CapeAction : public btActionInterface {
     btTransform stepStart;         ///< Pose at the start of this internal step.
     btTransform stepEnd;           ///< Pose at the end of this internal step.
     bool jumped = false;           ///< Teleported in this step: no sweep.
-    bool present = false;          ///< Still in the world at this update.
+    bool present = false;          ///< Still in the world at this update (set by a full scan).
+    int worldIndex = -1;           ///< Index in the world's collision object array when last seen there
+                                   ///< (a hint: checked by pointer comparison before it is trusted).
     bool explicitCollider = false;
     bool discovered = false;  ///< Found by discovery for this step.
     bool converted = false;
@@ -199,6 +215,8 @@ class CapeAction : public btActionInterface {
 
   std::vector<Tracked> tracked_;
   std::unordered_map<const btCollisionObject*, std::size_t> trackedIndex_;
+  /// Discovery's scratch: (world array index, object) of every object the broadphase reported this step.
+  std::vector<std::pair<int, const btCollisionObject*>> found_;
 
   std::vector<Collider> colliders_;
   std::vector<const btCollisionObject*> activeObjects_;
