@@ -69,6 +69,19 @@ json colliderJson(const Collider& c) {
       j["constant"] = c.constant + n.dot(p.position);
       break;
     }
+    case ColliderShape::ConvexHull: {
+      // In the collider's frame: its vertices and outward face planes (unit normal, offset: n . p = offset
+      // on the face), enough to recompute a particle's penetration from the files alone.
+      json vertices = json::array(), planes = json::array();
+      for (const Vec3& v : c.hull->vertices) vertices.push_back(vec(v));
+      for (const Eigen::Vector4f& q : c.hull->planes) planes.push_back({{"normal", vec(q.head<3>())}, {"offset", q[3]}});
+      j["vertices"] = std::move(vertices);
+      j["planes"] = std::move(planes);
+      break;
+    }
+    case ColliderShape::TriangleMesh:
+      j["triangles_near_cape"] = c.triangles->size();  // gathered for this step, in the collider's frame
+      break;
   }
   if (c.thickness > 0.0f) j["thickness"] = c.thickness;
   return j;

@@ -80,6 +80,29 @@ void box(const Vec3& h, ShapeMesh& mesh) {
   }
 }
 
+/// Each face of a hull: the vertices on its plane, in order around the face's centre, as a fan.
+void hullFaces(const ConvexHull& hull, ShapeMesh& mesh) {
+  for (const Eigen::Vector4f& q : hull.planes) {
+    const Vec3 n = q.head<3>();
+    std::vector<Vec3> face;
+    for (const Vec3& v : hull.vertices)
+      if (std::abs(n.dot(v) - q[3]) < 1e-4f) face.push_back(v);
+    if (face.size() < 3) continue;
+    Vec3 centre = Vec3::Zero();
+    for (const Vec3& v : face) centre += v / static_cast<float>(face.size());
+    const Vec3 t = (face[0] - centre).normalized(), b = n.cross(t);
+    std::sort(face.begin(), face.end(), [&](const Vec3& u, const Vec3& v) {
+      return std::atan2((u - centre).dot(b), (u - centre).dot(t)) < std::atan2((v - centre).dot(b), (v - centre).dot(t));
+    });
+    const auto first = static_cast<std::uint32_t>(mesh.positions.size() / 3);
+    for (const Vec3& v : face) {
+      mesh.positions.insert(mesh.positions.end(), {v.x(), v.y(), v.z()});
+      mesh.normals.insert(mesh.normals.end(), {n.x(), n.y(), n.z()});
+    }
+    for (std::uint32_t k = 1; k + 1 < face.size(); ++k) mesh.indices.insert(mesh.indices.end(), {first, first + k, first + k + 1});
+  }
+}
+
 }  // namespace
 
 ShapeMesh colliderMesh(const Collider& c, int segments, float planeHalfSize) {
@@ -129,6 +152,20 @@ ShapeMesh colliderMesh(const Collider& c, int segments, float planeHalfSize) {
       mesh.indices = {0, 1, 2, 0, 2, 3};
       break;
     }
+    case ColliderShape::ConvexHull:
+      hullFaces(*c.hull, mesh);
+      break;
+    case ColliderShape::TriangleMesh:
+      for (std::size_t t = 0; t < c.triangles->size(); ++t) {
+        const Vec3* v = &c.triangles->corners[3 * t];
+        const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+        for (int k = 0; k < 3; ++k) {
+          mesh.indices.push_back(static_cast<std::uint32_t>(mesh.positions.size() / 3));
+          mesh.positions.insert(mesh.positions.end(), {v[k].x(), v[k].y(), v[k].z()});
+          mesh.normals.insert(mesh.normals.end(), {n.x(), n.y(), n.z()});
+        }
+      }
+      break;
   }
   return mesh;
 }

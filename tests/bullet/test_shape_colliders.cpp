@@ -6,6 +6,8 @@
 #include <btBulletCollisionCommon.h>
 #include <gtest/gtest.h>
 
+#include <BulletCollision/CollisionShapes/btTriangleShape.h>
+
 #include <memory>
 
 using cape::ColliderShape;
@@ -84,8 +86,8 @@ TEST(ShapeColliders, MultiSpherePlaneConvexMeshAndEmpty) {
   const btScalar radii[2] = {0.1f, 0.15f};
   btMultiSphereShape multi(centres, radii, 2);
   auto m = convertShape(&multi);
-  EXPECT_EQ(m.primitives.size(), 2u);
-  EXPECT_EQ(m.convex.size(), 1u);  // the hull between the spheres
+  ASSERT_EQ(m.primitives.size(), 3u);  // the two spheres and the sampled hull between them
+  EXPECT_EQ(m.primitives[2].collider.shape, ColliderShape::ConvexHull);
   EXPECT_NEAR(m.primitives[1].collider.radius, 0.15f, 1e-6f);
   EXPECT_NEAR(m.primitives[1].local.getOrigin().x(), 0.2f, 1e-6f);
 
@@ -95,8 +97,26 @@ TEST(ShapeColliders, MultiSpherePlaneConvexMeshAndEmpty) {
   EXPECT_EQ(p.primitives[0].collider.shape, ColliderShape::Plane);
   EXPECT_NEAR(p.primitives[0].collider.constant, 0.5f, 1e-6f);
 
+  // Any other convex shape: its support mapping sampled into a hull, whose every vertex lies on the
+  // shape's surface without margin (the margin is the collider's thickness).
   btConeShape cone(0.2f, 0.5f);
-  EXPECT_EQ(convertShape(&cone).convex.size(), 1u);
+  auto k = convertShape(&cone);
+  ASSERT_EQ(k.primitives.size(), 1u);
+  const cape::Collider& hull = k.primitives[0].collider;
+  ASSERT_EQ(hull.shape, ColliderShape::ConvexHull);
+  EXPECT_TRUE(hull.hull->validate().ok());
+  EXPECT_FLOAT_EQ(hull.thickness, float(cone.getMargin()));
+  for (const cape::Vec3& v : hull.hull->vertices) {
+    EXPECT_LE(v.y(), 0.25f + 1e-5f);
+    EXPECT_GE(v.y(), -0.25f - 1e-5f);
+    // Inside the cone without margin: radius at height y is 0.2 (0.25 - y) / 0.5.
+    EXPECT_LE(std::hypot(v.x(), v.z()), 0.2f * (0.25f - v.y()) / 0.5f + 1e-4f) << v.transpose();
+  }
+  // A flat shape (a triangle) has no volume: reported, not collided with.
+  btTriangleShape flat(btVector3(0, 0, 0), btVector3(1, 0, 0), btVector3(0, 0, 1));
+  auto f = convertShape(&flat);
+  EXPECT_TRUE(f.primitives.empty());
+  EXPECT_EQ(f.unsupported.size(), 1u);
 
   btEmptyShape empty;
   auto e = convertShape(&empty);

@@ -2,8 +2,8 @@
 //   1. prepare (reads the world): drop bodies that left the world (an index check per followed object, a
 //      scan of the world's array only when one fails), discover colliders (the broadphase's aabbTest),
 //      advance every followed body's pose by one internal step, teleport and inertia, pin targets, core
-//      colliders;
-//   2. advance (this cape only): Cape::step, then the post-pass for GJK convex shapes and triangle meshes.
+//      colliders (and the triangles of meshes near the cape, from Bullet's mesh queries);
+//   2. advance (this cape only): Cape::step, which resolves every collider inside its substeps.
 #include "cape/bullet/CapeAction.h"
 
 #include "cape/bullet/Convert.h"
@@ -46,16 +46,6 @@ btTransform interpolate(const btTransform& a, const btTransform& b, btScalar s) 
   return btTransform(qa.slerp(qb, s), a.getOrigin().lerp(b.getOrigin(), s));
 }
 
-/// Collects the triangles Bullet reports over a box (local frame of the shape).
-struct TriangleCollector : btTriangleCallback {
-  std::vector<btVector3>* out;
-  explicit TriangleCollector(std::vector<btVector3>* o) : out(o) {}
-  void processTriangle(btVector3* t, int, int) override {
-    out->push_back(t[0]);
-    out->push_back(t[1]);
-    out->push_back(t[2]);
-  }
-};
 
 /// Discovery's broadphase query: keeps every proxy the rule accepts, with its object's index in the world's
 /// collision object array. Bullet calls process() only for proxies in its broadphase, i.e. for objects in
@@ -384,13 +374,7 @@ void CapeAction::applyInertia() {
   // Every particle, and where every pin starts this step, moves alike: otherwise the pins would sweep from
   // their old place while the free particles already stand in the new one, and the springs between them
   // would turn the difference into motion.
-  CapeState& s = cape_.mutableState();
-  for (Eigen::Index i = 0; i < s.positions.rows(); ++i) {
-    const Vec3 x = s.positions.row(i).transpose();
-    s.positions.row(i) = (m * (x - centre) + centre + shift).transpose();
-    s.velocities.row(i) = (m * Vec3(s.velocities.row(i).transpose())).transpose();
-  }
-  for (Pin& p : s.pins) p.previousTarget = m * (p.previousTarget - centre) + centre + shift;
+  cape_.carry(m, centre, shift);
 }
 
 void CapeAction::updatePins() {
@@ -411,8 +395,7 @@ void CapeAction::updatePins() {
 void CapeAction::buildColliders() {
   colliders_.clear();
   activeObjects_.clear();
-  convexParts_.clear();
-  concaveParts_.clear();
+  meshCount_ = 0;
   for (Tracked& t : tracked_) {
     if (!t.explicitCollider && !t.discovered) continue;
     if (!t.converted) {
@@ -420,24 +403,65 @@ void CapeAction::buildColliders() {
       t.converted = true;
       for (const std::string& name : t.shape.unsupported)
         warnOnce("shape:" + name, "unsupported collision shape '" + name + "' ignored by the cape");
+      t.soups.clear();
+      for (std::size_t k = 0; k < t.shape.meshes.size(); ++k) t.soups.push_back(std::make_shared<TriangleSoup>());
     }
     if (t.shape.empty()) continue;
     activeObjects_.push_back(t.object);
+    // The collider's own friction, combined with the cape's as Bullet combines two materials (and as
+    // btSoftBody does with its kDF): the product.
+    const float friction = cape_.settings().friction * float(t.object->getFriction());
     for (const ShapeConversion::Primitive& p : t.shape.primitives) {
       Collider c = p.collider;
       c.previous = toPose(t.stepStart * p.local);
       c.current = toPose(t.stepEnd * p.local);
+      c.friction = friction;
       if (c.shape == ColliderShape::Plane) {
         // Planes are static half-spaces: the core reads their normal and constant in the collider frame.
         c.previous = c.current;
       }
       colliders_.push_back(std::move(c));
     }
-    for (const ShapeConversion::Special& s : t.shape.convex)
-      convexParts_.push_back({s.shape, t.stepEnd * s.local});
-    for (const ShapeConversion::Special& s : t.shape.concave)
-      concaveParts_.push_back({s.shape, t.stepEnd * s.local});
+    for (std::size_t k = 0; k < t.shape.meshes.size(); ++k) {
+      const ShapeConversion::Mesh& m = t.shape.meshes[k];
+      const btTransform start = t.stepStart * m.local, end = t.stepEnd * m.local;
+      gatherTriangles(m.shape, start, end, *t.soups[k]);
+      Collider c = Collider::triangleMesh(t.soups[k], toPose(end));
+      c.previous = toPose(start);
+      c.thickness = float(m.shape->getMargin());  // Bullet's skin over the triangles
+      c.friction = friction;
+      c.name = m.shape->getName();
+      colliders_.push_back(std::move(c));
+      ++meshCount_;
+    }
   }
+}
+
+void CapeAction::gatherTriangles(const btConcaveShape* shape, const btTransform& start, const btTransform& end,
+                                 TriangleSoup& soup) const {
+  // Bullet's mesh query, once per step: the triangles in the box of the cape's bounds grown by the reach of
+  // one step (the discovery margin) and the skins, in the shape's frame at the step's start and its end.
+  struct Collect : btTriangleCallback {
+    TriangleSoup* soup;
+    void processTriangle(btVector3* t, int, int) override {
+      for (int k = 0; k < 3; ++k) soup->corners.push_back(toVec3(t[k]));
+    }
+  } collect;
+  collect.soup = &soup;
+  soup.corners.clear();  // keeps its capacity: no allocation once the cape has met the mesh
+  const Points& x = positions();
+  const btScalar grow = btScalar(cape_.settings().collisionThickness) + shape->getMargin() + settings_.discoveryMargin;
+  const btVector3 lo = toBt(Vec3(x.colwise().minCoeff().transpose())) - btVector3(grow, grow, grow);
+  const btVector3 hi = toBt(Vec3(x.colwise().maxCoeff().transpose())) + btVector3(grow, grow, grow);
+  btVector3 qlo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), qhi = -qlo;
+  for (const btTransform* pose : {&start, &end})
+    for (int corner = 0; corner < 8; ++corner) {
+      const btVector3 p = pose->invXform(btVector3(corner & 1 ? hi.x() : lo.x(), corner & 2 ? hi.y() : lo.y(),
+                                                   corner & 4 ? hi.z() : lo.z()));
+      qlo.setMin(p);
+      qhi.setMax(p);
+    }
+  shape->processAllTriangles(&collect, qlo, qhi);
 }
 
 void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
@@ -457,121 +481,13 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
 void CapeAction::advance(btScalar dt) {
   if (!ok() || !(dt > 0)) return;
   const auto start = std::chrono::steady_clock::now();
-  const bool post = !convexParts_.empty() || !concaveParts_.empty();
-  if (post) stepStartPositions_ = positions();
   cape_.step(static_cast<float>(dt), ColliderSpan(colliders_));
-  if (!convexParts_.empty()) convexPass(dt);
-  if (!concaveParts_.empty()) concavePass(dt);
   ++stepCount_;
   lastStepMicroseconds_ =
       prepareMicroseconds_ +
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   prepareMicroseconds_ = 0.0;
   accumulatedMicroseconds_ += lastStepMicroseconds_;
-}
-
-void CapeAction::respond(Eigen::Index i, const Vec3& normal, float pushDistance, btScalar dt) {
-  // An inelastic contact: the velocity into the surface goes; Coulomb friction takes from the tangential
-  // velocity at most mu times the normal velocity change (the push over the step, plus the velocity removed).
-  CapeState& s = cape_.mutableState();
-  Vec3 v = s.velocities.row(i).transpose();
-  const float vn = v.dot(normal);
-  float dvn = pushDistance / static_cast<float>(dt);
-  if (vn < 0.0f) {
-    v -= vn * normal;
-    dvn -= vn;
-  }
-  const Vec3 vt = v - v.dot(normal) * normal;
-  const float vtLen = vt.norm();
-  if (vtLen > 0.0f) v -= vt * (std::min(vtLen, cape_.settings().friction * dvn) / vtLen);
-  s.velocities.row(i) = v.transpose();
-}
-
-void CapeAction::convexPass(btScalar dt) {
-  // After the core step: every free particle closer to a convex shape's true surface than the cape's
-  // thickness goes out along the GJK/EPA normal, and loses the velocity that points into the shape.
-  CapeState& s = cape_.mutableState();
-  const btScalar thickness = btScalar(cape_.settings().collisionThickness);
-  for (const PlacedSpecial& part : convexParts_) {
-    const auto* shape = static_cast<const btConvexShape*>(part.shape);
-    btVector3 lo, hi;
-    shape->getAabb(part.world, lo, hi);
-    const btVector3 grow(thickness, thickness, thickness);
-    lo -= grow;
-    hi += grow;
-    for (Eigen::Index i = 0; i < s.positions.rows(); ++i) {
-      if (s.inverseMasses[i] == 0.0f) continue;
-      const btVector3 p = toBt(Vec3(s.positions.row(i).transpose()));
-      if (!TestPointAgainstAabb2(lo, hi, p)) continue;
-      btScalar d = 0;
-      btVector3 n;
-      if (!convexSignedDistance(shape, part.world, p, d, n) || d >= thickness) continue;
-      s.positions.row(i) = toVec3(p + n * (thickness - d)).transpose();
-      respond(i, toVec3(n), static_cast<float>(thickness - d), dt);
-    }
-  }
-}
-
-void CapeAction::concavePass(btScalar dt) {
-  // After the core step: particle against triangle. Each particle keeps the side of every nearby triangle it
-  // was on at the start of the step (so a particle that crossed a thin face this step comes back), at least
-  // the thickness (plus the shape's margin, the skin Bullet's own contacts keep) away from it.
-  CapeState& s = cape_.mutableState();
-  for (const PlacedSpecial& part : concaveParts_) {
-    const auto* shape = static_cast<const btConcaveShape*>(part.shape);
-    const btScalar keep = btScalar(cape_.settings().collisionThickness) + shape->getMargin();
-    btVector3 lo, hi;
-    shape->getAabb(part.world, lo, hi);
-    const btVector3 grow(keep, keep, keep);
-    const btMatrix3x3& basis = part.world.getBasis();
-    for (Eigen::Index i = 0; i < s.positions.rows(); ++i) {
-      if (s.inverseMasses[i] == 0.0f) continue;
-      const btVector3 pw = toBt(Vec3(s.positions.row(i).transpose()));
-      const btVector3 p0w = toBt(Vec3(stepStartPositions_.row(i).transpose()));
-      btVector3 boxLo = pw, boxHi = pw;
-      boxLo.setMin(p0w);
-      boxHi.setMax(p0w);
-      if (!TestAabbAgainstAabb2(boxLo - grow, boxHi + grow, lo, hi)) continue;
-      btVector3 p = part.world.invXform(pw);
-      const btVector3 p0 = part.world.invXform(p0w);
-      btVector3 qlo = p, qhi = p;
-      qlo.setMin(p0);
-      qhi.setMax(p0);
-      triangleScratch_.clear();
-      TriangleCollector collect(&triangleScratch_);
-      shape->processAllTriangles(&collect, qlo - grow, qhi + grow);
-      if (triangleScratch_.empty()) continue;
-      btVector3 pushed(0, 0, 0);
-      for (std::size_t k = 0; k + 2 < triangleScratch_.size(); k += 3) {
-        const btVector3 &a = triangleScratch_[k], &b = triangleScratch_[k + 1], &c = triangleScratch_[k + 2];
-        btVector3 n = (b - a).cross(c - a);
-        const btScalar len = n.length();
-        if (!(len > btScalar(1e-12))) continue;
-        n /= len;
-        const btScalar side0 = n.dot(p0 - a);
-        const btScalar side = side0 < 0 ? btScalar(-1) : btScalar(1);
-        bool onFace = false;
-        const btVector3 q = closestOnTriangle(p, a, b, c, &onFace);
-        if (onFace) {
-          const btScalar d = side * n.dot(p - a);
-          if (d < keep) {
-            p += (side * n) * (keep - d);
-            pushed = side * n;
-          }
-        } else {
-          const btVector3 e = p - q;
-          const btScalar d = e.length();
-          if (d < keep && d > btScalar(1e-9)) {
-            p += e * ((keep - d) / d);
-            pushed = e / d;
-          }
-        }
-      }
-      if (pushed.isZero()) continue;
-      s.positions.row(i) = toVec3(part.world * p).transpose();
-      respond(i, toVec3(basis * pushed), static_cast<float>((part.world * p - pw).length()), dt);
-    }
-  }
 }
 
 void CapeAction::debugDraw(btIDebugDraw* drawer) {

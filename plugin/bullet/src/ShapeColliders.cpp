@@ -13,7 +13,9 @@
 #include <BulletCollision/CollisionShapes/btSphereShape.h>
 #include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
 #include <BulletCollision/CollisionShapes/btTriangleCallback.h>
+#include <BulletCollision/CollisionShapes/btPolyhedralConvexShape.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
+#include <LinearMath/btConvexHullComputer.h>
 
 #include <algorithm>
 #include <cmath>
@@ -33,6 +35,32 @@ namespace {
 void addPrimitive(ShapeConversion& out, Collider c, const btTransform& local, const char* name) {
   c.name = name;
   out.primitives.push_back({std::move(c), local});
+}
+
+/// 162 directions spread evenly over the sphere (a Fibonacci lattice): deterministic, no two alike.
+const std::vector<btVector3>& sampleDirections() {
+  static const std::vector<btVector3> directions = [] {
+    constexpr int kCount = 162;
+    std::vector<btVector3> d;
+    const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < kCount; ++i) {
+      const double z = 1.0 - (2.0 * i + 1.0) / kCount, r = std::sqrt(1.0 - z * z), phi = golden * i;
+      d.emplace_back(btScalar(r * std::cos(phi)), btScalar(r * std::sin(phi)), btScalar(z));
+    }
+    return d;
+  }();
+  return directions;
+}
+
+void addHull(ShapeConversion& out, const btConvexShape* shape, const btTransform& local) {
+  std::shared_ptr<const ConvexHull> hull = convexHullOf(shape);
+  if (!hull) {
+    out.unsupported.push_back(std::string(shape->getName()) + " (flat or degenerate: no volume to collide with)");
+    return;
+  }
+  Collider c = Collider::convexHull(std::move(hull));
+  c.thickness = float(shape->getMargin());  // Bullet's skin around the hull
+  addPrimitive(out, std::move(c), local, shape->getName());
 }
 
 bool isSupportedConcave(int type) {
@@ -83,9 +111,9 @@ void convertInto(ShapeConversion& out, const btCollisionShape* shape, const btTr
         addPrimitive(out, Collider::sphere(float(m->getSphereRadius(i) * radiusScale)), t,
                      "btMultiSphereShape");
       }
-      // Bullet's multi-sphere is the convex hull of its spheres, not their union: the spheres are swept by
-      // the core (fast motion), and GJK keeps particles out of the hull between them after the step.
-      out.convex.push_back({shape, local});
+      // Bullet's multi-sphere is the convex hull of its spheres, not their union: the spheres are exact, and
+      // the sampled hull covers the space between them.
+      addHull(out, m, local);
       return;
     }
     case STATIC_PLANE_PROXYTYPE: {
@@ -109,9 +137,9 @@ void convertInto(ShapeConversion& out, const btCollisionShape* shape, const btTr
       break;
   }
   if (shape->isConvex()) {
-    out.convex.push_back({shape, local});
+    addHull(out, static_cast<const btConvexShape*>(shape), local);
   } else if (isSupportedConcave(type)) {
-    out.concave.push_back({shape, local});
+    out.meshes.push_back({static_cast<const btConcaveShape*>(shape), local});
   } else {
     out.unsupported.emplace_back(shape->getName());
   }
@@ -128,6 +156,61 @@ struct NearestTriangle : btTriangleCallback {
 };
 
 }  // namespace
+
+std::shared_ptr<const ConvexHull> convexHullOf(const btConvexShape* shape) {
+  if (shape == nullptr) return nullptr;
+  std::vector<btVector3> points;
+  const auto* poly = shape->isPolyhedral() ? static_cast<const btPolyhedralConvexShape*>(shape) : nullptr;
+  if (poly != nullptr && poly->getNumVertices() >= 4) {
+    for (int i = 0; i < poly->getNumVertices(); ++i) {
+      btVector3 v;
+      poly->getVertex(i, v);  // scaled, without margin
+      points.push_back(v);
+    }
+  } else {
+    for (const btVector3& d : sampleDirections()) points.push_back(shape->localGetSupportingVertexWithoutMargin(d));
+  }
+  for (const btVector3& p : points)
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) return nullptr;
+  btConvexHullComputer computer;
+  computer.compute(&points[0].x(), sizeof(btVector3), static_cast<int>(points.size()), btScalar(0), btScalar(0));
+  if (computer.vertices.size() < 4 || computer.faces.size() < 4) return nullptr;
+  std::vector<Vec3> vertices;
+  Vec3 centre = Vec3::Zero();
+  for (int i = 0; i < computer.vertices.size(); ++i) {
+    vertices.push_back(toVec3(computer.vertices[i]));
+    centre += vertices.back() / float(computer.vertices.size());
+  }
+  std::vector<Eigen::Vector4f> planes;
+  for (int f = 0; f < computer.faces.size(); ++f) {
+    // Newell's normal over the face's vertices (robust for faces of many nearly coplanar points).
+    const btConvexHullComputer::Edge* start = &computer.edges[computer.faces[f]];
+    const btConvexHullComputer::Edge* e = start;
+    Eigen::Vector3d n = Eigen::Vector3d::Zero(), mean = Eigen::Vector3d::Zero();
+    int count = 0;
+    do {
+      const Eigen::Vector3d a = vertices[std::size_t(e->getSourceVertex())].cast<double>();
+      const Eigen::Vector3d b = vertices[std::size_t(e->getTargetVertex())].cast<double>();
+      n += Eigen::Vector3d((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()), (a.x() - b.x()) * (a.y() + b.y()));
+      mean += a;
+      ++count;
+      e = e->getNextEdgeOfFace();
+    } while (e != start && count < 1024);
+    if (!(n.norm() > 1e-12)) continue;
+    n.normalize();
+    mean /= count;
+    double offset = n.dot(mean);
+    if (n.dot(centre.cast<double>()) > offset) {  // keep the normals outward
+      n = -n;
+      offset = -offset;
+    }
+    // Every vertex on the solid side (the face's points are coplanar only to rounding).
+    for (const Vec3& v : vertices) offset = std::max(offset, n.dot(v.cast<double>()));
+    planes.emplace_back(float(n.x()), float(n.y()), float(n.z()), float(offset));
+  }
+  std::shared_ptr<const ConvexHull> hull = ConvexHull::make(std::move(vertices), std::move(planes));
+  return hull->validate().ok() ? hull : nullptr;
+}
 
 ShapeConversion convertShape(const btCollisionShape* shape, const btTransform& local) {
   ShapeConversion out;

@@ -156,6 +156,16 @@ void Cape::teleport(const Pose& delta) {
   }
 }
 
+void Cape::carry(const Eigen::Matrix3f& m, const Vec3& centre, const Vec3& shift) {
+  if (!ok() || !m.allFinite() || !centre.allFinite() || !shift.allFinite()) return;
+  for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
+    const Vec3 x = state_.positions.row(i).transpose();
+    state_.positions.row(i) = (m * (x - centre) + centre + shift).transpose();
+    state_.velocities.row(i) = (m * Vec3(state_.velocities.row(i).transpose())).transpose();
+  }
+  for (Pin& p : state_.pins) p.previousTarget = m * (p.previousTarget - centre) + centre + shift;
+}
+
 void Cape::step(float dt, ColliderSpan colliders) {
   if (!ok() || !std::isfinite(dt) || !(dt > 0.0f)) return;
   const StepPlan plan = planSubsteps(dt);

@@ -132,9 +132,9 @@ class CapeAction : public btActionInterface {
   const std::vector<Collider>& coreColliders() const { return colliders_; }
   /// The collision objects whose shapes were used in the last step (in a deterministic order).
   const std::vector<const btCollisionObject*>& activeObjects() const { return activeObjects_; }
-  /// Convex shapes handled by GJK and concave shapes by triangles in the last step.
-  std::size_t gjkShapeCount() const { return convexParts_.size(); }
-  std::size_t meshShapeCount() const { return concaveParts_.size(); }
+  /// Triangle-mesh colliders (meshes, heightfields) in the last step; their triangles near the cape are
+  /// gathered with Bullet's mesh queries once per step.
+  std::size_t meshShapeCount() const { return meshCount_; }
 
   // --- Stepping ----------------------------------------------------------------------------------------
   /// One internal step of the world (dt s): prepare() then advance().
@@ -186,6 +186,7 @@ class CapeAction : public btActionInterface {
     bool discovered = false;  ///< Found by discovery for this step.
     bool converted = false;
     ShapeConversion shape;
+    std::vector<std::shared_ptr<TriangleSoup>> soups;  ///< One per shape.meshes, refilled every step.
   };
 
   Tracked& track(const btCollisionObject* object);
@@ -197,9 +198,8 @@ class CapeAction : public btActionInterface {
   void applyInertia();
   void updatePins();
   void buildColliders();
-  void convexPass(btScalar dt);
-  void concavePass(btScalar dt);
-  void respond(Eigen::Index particle, const Vec3& normal, float pushDistance, btScalar dt);
+  void gatherTriangles(const btConcaveShape* shape, const btTransform& start, const btTransform& end,
+                       TriangleSoup& soup) const;
   void refreshPinIndices();
   void warnOnce(const std::string& key, const std::string& message);
   const btRigidBody* referenceBody() const;
@@ -220,14 +220,7 @@ class CapeAction : public btActionInterface {
 
   std::vector<Collider> colliders_;
   std::vector<const btCollisionObject*> activeObjects_;
-  struct PlacedSpecial {
-    const btCollisionShape* shape;
-    btTransform world;
-  };
-  std::vector<PlacedSpecial> convexParts_;
-  std::vector<PlacedSpecial> concaveParts_;
-  Points stepStartPositions_;
-  std::vector<btVector3> triangleScratch_;
+  std::size_t meshCount_ = 0;
 
   bool teleported_ = false;
   std::uint64_t stepCount_ = 0;

@@ -1,16 +1,20 @@
-// Bullet collision shapes as cape colliders. Shapes the core knows analytically (sphere, box, capsule,
-// cylinder, the spheres of a btMultiSphereShape, a static plane; compounds of these, nested) become
-// cape::Collider values swept by the core; any other convex shape is handled by Bullet's own GJK/EPA signed
-// distance, and triangle meshes (btBvhTriangleMeshShape, btScaledBvhTriangleMeshShape, heightfields) by
-// particle-triangle contacts, both in a pass after the core's step.
+// Bullet collision shapes as cape colliders, all resolved by the core inside its substeps. Shapes the core
+// knows analytically (sphere, box, capsule, cylinder, a static plane; compounds, nested) become those
+// colliders; every other convex shape becomes a core convex hull (a btConvexHullShape's own points, any
+// other shape's support mapping sampled in 162 directions), its collision margin the collider's thickness;
+// triangle meshes (btBvhTriangleMeshShape, btScaledBvhTriangleMeshShape, heightfields) become core
+// triangle-mesh colliders whose triangles near the cape the action gathers with Bullet's mesh queries once
+// per step.
 #pragma once
 
 #include "cape/core/Collider.h"
 
 #include <BulletCollision/CollisionShapes/btCollisionShape.h>
+#include <BulletCollision/CollisionShapes/btConcaveShape.h>
 #include <BulletCollision/CollisionShapes/btConvexShape.h>
 #include <LinearMath/btTransform.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,15 +27,14 @@ struct ShapeConversion {
     Collider collider;  ///< Sizes filled in; poses are set every step.
     btTransform local;
   };
-  struct Special {
-    const btCollisionShape* shape;  ///< btConvexShape (GJK) or btConcaveShape (triangles).
+  struct Mesh {
+    const btConcaveShape* shape;  ///< Queried for its triangles near the cape every step.
     btTransform local;
   };
-  std::vector<Primitive> primitives;     ///< Swept by the core.
-  std::vector<Special> convex;           ///< Through btGjkEpaSolver2::SignedDistance after the core step.
-  std::vector<Special> concave;          ///< Particle-triangle contacts after the core step.
-  std::vector<std::string> unsupported;  ///< Names (btCollisionShape::getName) of shapes left out.
-  bool empty() const { return primitives.empty() && convex.empty() && concave.empty(); }
+  std::vector<Primitive> primitives;     ///< Analytic shapes and convex hulls, swept by the core.
+  std::vector<Mesh> meshes;              ///< Triangle meshes and heightfields.
+  std::vector<std::string> unsupported;  ///< Names (btCollisionShape::getName) of shapes left out, and why.
+  bool empty() const { return primitives.empty() && meshes.empty(); }
 };
 
 /// Converts a shape (with local scaling and collision margins: the sizes describe the surface Bullet's own
@@ -41,10 +44,16 @@ struct ShapeConversion {
 /// Scaling: btSphereShape, btBoxShape, btCapsuleShape and btCylinderShape report their scaled sizes; a
 /// btMultiSphereShape's sphere centres are scaled per axis and its radii by the largest scale component
 /// (exact for uniform scaling); a btStaticPlaneShape's scaling is ignored (a plane has no size).
-/// A btMultiSphereShape is the convex hull of its spheres: its spheres are core colliders and the shape
-/// also goes to the GJK pass, which keeps particles out of the hull between the spheres.
+/// A btMultiSphereShape is the convex hull of its spheres: its spheres are core colliders, and its sampled
+/// hull keeps particles out of the space between them.
 ShapeConversion convertShape(const btCollisionShape* shape,
                              const btTransform& local = btTransform::getIdentity());
+
+/// The core convex hull of a convex shape without its margin (a btPolyhedralConvexShape's vertices, scaled;
+/// any other shape's support points without margin in 162 directions spread over the sphere), through
+/// Bullet's btConvexHullComputer; the shape's margin is for the collider's thickness. nullptr for a flat
+/// or degenerate shape (fewer than four points off one plane).
+std::shared_ptr<const ConvexHull> convexHullOf(const btConvexShape* shape);
 
 /// Signed distance from a world point to a convex shape's true surface (margin included), m, negative
 /// inside, and the outward unit normal at the nearest surface point. Uses Bullet's GJK (outside and within

@@ -63,6 +63,11 @@ class Cape {
   /// Moves every particle and target rigidly by `delta` (pose applied to world positions) and rotates
   /// velocities with it: what a teleport of the character does to its cape, without stretching it.
   void teleport(const Pose& delta);
+  /// Carries every particle, and the start of every pin's sweep, by x -> rotation (x - centre) + centre +
+  /// shift, velocities turned by the rotation; the pins' targets at the end of the next step stay. What a
+  /// character-cloth "inertia" below 1 does before a step: the part of the body's motion the cape should not
+  /// feel (CapeActionSettings::linearInertia). Ignored unless every input is finite.
+  void carry(const Eigen::Matrix3f& rotation, const Vec3& centre, const Vec3& shift);
 
   /// Advances the cape by dt seconds against the colliders, which are swept from their previous to their
   /// current pose, in substeps of about settings().timeStep / settings().substeps (see CapeSettings::substeps).
