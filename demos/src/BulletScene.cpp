@@ -14,7 +14,7 @@ namespace {
 using bullet::toBt;
 using bullet::toVec3;
 
-// SCENARIOS.md: the pins lie on the line (+-0.30, 1.56, 0.15) of the character frame, 4 cm above and 15 cm
+// docs/SCENES.md: the pins lie on the line (+-0.30, 1.56, 0.15) of the character frame, 4 cm above and 15 cm
 // behind the shoulder centres (+-0.22, 1.52, 0).
 const Vec3 kPinLineCentre(0.0f, 1.56f, 0.15f);
 const Vec3 kPinLineFromShoulders(0.0f, 0.04f, 0.15f);
@@ -133,13 +133,13 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
     }
     body_ = (o.urdf.empty() ? std::string("the shipped humanoid (character/models/humanoid.urdf)") : "URDF " + o.urdf);
   } else {
-    body_ = "the simple body of SCENARIOS.md as kinematic Bullet bodies";
+    body_ = "the simple body of docs/SCENES.md as kinematic Bullet bodies";
   }
 
   for (int k = 0; k < count; ++k) {
     auto c = std::make_unique<Character>();
     c->offset = crowdOffset(k, count);
-    Vec3 shift = c->offset;  // moves SCENARIOS.md's pin line onto this character's
+    Vec3 shift = c->offset;  // moves docs/SCENES.md's pin line onto this character's
     std::vector<std::pair<float, btRigidBody*>> anchors;  // attachment bodies by their x at rest
     if (model) {
       character::CharacterSettings cs;
@@ -182,7 +182,7 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
     }
     std::sort(anchors.begin(), anchors.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
 
-    // The cape starts as SCENARIOS.md says, moved onto this character's pin line; each pinned particle goes
+    // The cape starts as docs/SCENES.md says, moved onto this character's pin line; each pinned particle goes
     // to the attachment body nearest to it along X (left corner to the left shoulder, and so on).
     const Pose start = capeStartPlacement(o.scene);
     c->placement.position = start.position + shift;

@@ -1,7 +1,7 @@
-// The canonical scenes of shared/SCENARIOS.md in a Bullet world: each character as kinematic rigid bodies
-// (the shipped humanoid or a URDF through the character library, or the simple body of SCENARIOS.md), a
+// The canonical scenes of docs/SCENES.md in a Bullet world: each character as kinematic rigid bodies
+// (the shipped humanoid or a URDF through the character library, or the simple body of docs/SCENES.md), a
 // static ground plane, and where each character's cape starts and which bodies it is pinned to. The world is
-// stepped as SCENARIOS.md says: stepSimulation(1/60, 8, 1/240). cape_walk puts our cape on it; cape_compare
+// stepped as docs/SCENES.md says: stepSimulation(1/60, 8, 1/240). cape_walk puts our cape on it; cape_compare
 // puts our cape on one and the btSoftBody twin on another.
 #pragma once
 

@@ -1,5 +1,5 @@
 // What a run writes to its output folder (see the README, "Reading the outputs"):
-//   metrics.csv      one row per frame with every metric of shared/SCENARIOS.md
+//   metrics.csv      one row per frame with every metric of docs/SCENES.md
 //   summary.json     scene, settings, grid and cape dimensions, summary figures
 //   frames/NNNNN.obj the cape mesh of each frame (frames/kK/NNNNN.obj per character in a crowd)
 //   colliders.jsonl  one JSON object per frame with every body collider
@@ -54,7 +54,7 @@ class RunWriter {
   CapeMesh mesh_;
 };
 
-/// Summary figures of a run, the timings over frames 11..end as SCENARIOS.md defines them.
+/// Summary figures of a run, the timings over frames 11..end as docs/SCENES.md defines them.
 nlohmann::json summaryFigures(const std::vector<FrameRow>& rows, const RunSummary& quality);
 
 /// A fresh folder name in the current directory: <prefix>_<scene>_<YYYYmmdd-HHMMSS>[-N].

@@ -15,7 +15,7 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
   app.add_option("--characters", cli.characters, "characters in the crowd scene")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
-  app.add_flag("--simple-body", cli.simpleBody, "use the simple body of SCENARIOS.md instead of a URDF character");
+  app.add_flag("--simple-body", cli.simpleBody, "use the simple body of docs/SCENES.md instead of a URDF character");
   app.add_option("--urdf", cli.urdf, "character URDF file (default: the shipped humanoid)")->check(CLI::ExistingFile);
   app.add_option("--attach", cli.attach, "comma-separated links the cape pins to (default: links named *shoulder*)");
 }

@@ -1,6 +1,6 @@
 // cape_compare: the same scene (same character, colliders, attachments, stepping) with our cape and with the
 // btSoftBody twin (and optionally the twin in Bullet's deformable world), side by side. Prints one
-// row per solver with every metric of shared/SCENARIOS.md, the frame and cape times and each solver's cape
+// row per solver with every metric of docs/SCENES.md, the frame and cape times and each solver's cape
 // time relative to ours; writes compare.csv, compare.json,
 // per-frame CSVs and PNG plots. `cape_compare --help` lists the options.
 #include "BulletScene.h"
@@ -142,7 +142,7 @@ json deformableSettingsJson(const compare::DeformableTwinSettings& t) {
 
 int main(int argc, char** argv) {
   CLI::App app{"cape_compare: the same scene with our cape and with Bullet's btSoftBody twin (and, with "
-               "--with-deformable, its deformable-world twin), side by side; prints every metric of SCENARIOS.md per "
+               "--with-deformable, its deformable-world twin), side by side; prints every metric of docs/SCENES.md per "
                "solver and writes compare.csv, compare.json and PNG plots."};
   SceneCli sceneCli;
   std::string out;

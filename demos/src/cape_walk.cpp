@@ -1,5 +1,5 @@
 // cape_walk: the headless walking demo. A character walks (or stands, sprints and turns, stands in the wind,
-// or walks in a crowd), its cape follows, and every metric of shared/SCENARIOS.md is written per frame.
+// or walks in a crowd), its cape follows, and every metric of docs/SCENES.md is written per frame.
 // `cape_walk --help` lists the options; with none it runs the walk scene into a fresh folder it names.
 #include "GltfExport.h"
 #include "Progress.h"

@@ -9,7 +9,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 Quat yawRotation(float yaw) { return Quat(Eigen::AngleAxisf(yaw, Vec3::UnitY())); }
 
-// Torso, shoulders, legs of SCENARIOS.md, in the character frame.
+// Torso, shoulders, legs of docs/SCENES.md, in the character frame.
 const Vec3 kTorsoCentre(0.0f, 1.25f, 0.0f);
 const Vec3 kTorsoHalfExtents(0.20f, 0.30f, 0.12f);
 const Vec3 kShoulderCentre(0.22f, 1.52f, 0.0f);  // left shoulder is at -X (the character faces -Z)

@@ -1,4 +1,4 @@
-// Google Benchmark over the cape step in the canonical scenes of shared/SCENARIOS.md (simple body, no
+// Google Benchmark over the cape step in the canonical scenes of docs/SCENES.md (simple body, no
 // Bullet), for N x N capes. One benchmark iteration is one 1/60 s frame: the body and pins move, then the
 // cape steps. BM_WalkFrame keeps the substeps fixed (3 per frame: the cost of the step itself, and how it
 // scales with N); BM_WalkFrameAdaptive uses the default strain-adaptive substepping, which refines larger

@@ -5,7 +5,7 @@
 //
 // Scene: the canonical 20 x 20 cape pinned by its top corners to the walking character's shoulders (the pins
 // bob and move at 1.4 m/s), no colliders, 1/60 s frames, same stiffness, mass and damping. Reported per
-// configuration: time per frame and the strain of SCENARIOS.md (median and p95 over frames of the per-frame
+// configuration: time per frame and the strain of docs/SCENES.md (median and p95 over frames of the per-frame
 // maximum structural strain).
 #include "cape/scenes/Metrics.h"
 #include "cape/scenes/Scene.h"

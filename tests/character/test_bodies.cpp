@@ -1,5 +1,5 @@
 // Kinematic Bullet bodies: shapes, flags, groups, ownership, and that they follow the skeleton in a real
-// btDiscreteDynamicsWorld stepped as SCENARIOS.md says (stepSimulation(1/60, 8, 1/240)).
+// btDiscreteDynamicsWorld stepped as docs/SCENES.md says (stepSimulation(1/60, 8, 1/240)).
 #include "cape/character/Character.h"
 
 #include <gtest/gtest.h>

@@ -89,7 +89,7 @@ TEST(Gait, ReproducesTheScenesRootPathAndLegAngle) {
       EXPECT_LT((s.rootTransform().translation() - frame.position.cast<double>()).norm(), 1e-9) << t;
       const Eigen::Matrix3d yaw = Eigen::AngleAxisd(body.yaw, Eigen::Vector3d::UnitY()).toRotationMatrix();
       EXPECT_LT((s.rootTransform().linear() - yaw).cwiseAbs().maxCoeff(), 1e-9) << t;
-      // Hips: left +0.5236 sin(2 pi f t), right the negative (SCENARIOS.md), within the float of motionAt.
+      // Hips: left +0.5236 sin(2 pi f t), right the negative (docs/SCENES.md), within the float of motionAt.
       EXPECT_NEAR(s.jointPosition(leftHip), body.legAngle, 1e-6) << t;
       EXPECT_NEAR(s.jointPosition(rightHip), -body.legAngle, 1e-6) << t;
       // The left thigh points where the simple body's left leg points: down, turned by legAngle about X

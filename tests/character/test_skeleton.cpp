@@ -129,7 +129,7 @@ TEST(Skeleton, HumanoidStandsInTheWorldAsTheScenesSay) {
       bottom = std::min(bottom, c.y() - ext.y());
       if (*w.linkName == "torso") {
         EXPECT_TRUE(c.isApprox(Eigen::Vector3d(0, 1.25, 0), 1e-12));
-        EXPECT_TRUE(ext.isApprox(Eigen::Vector3d(0.20, 0.30, 0.12), 1e-12));  // SCENARIOS.md's torso
+        EXPECT_TRUE(ext.isApprox(Eigen::Vector3d(0.20, 0.30, 0.12), 1e-12));  // docs/SCENES.md's torso
       }
     }
   }
@@ -152,7 +152,7 @@ TEST(Skeleton, HumanoidStandsInTheWorldAsTheScenesSay) {
 }
 
 TEST(Skeleton, PositiveHipAngleSwingsTheLegForward) {
-  // The gait and SCENARIOS.md agree on the sign: left leg angle +0.5236 puts the foot ahead (towards -Z).
+  // The gait and docs/SCENES.md agree on the sign: left leg angle +0.5236 puts the foot ahead (towards -Z).
   Skeleton s(UrdfModel::humanoid().model);
   ASSERT_TRUE(s.setJointPosition("left_hip_pitch", 0.5236).ok());
   const Eigen::Vector3d knee = position(s, "left_shin");

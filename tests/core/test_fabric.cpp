@@ -1,4 +1,4 @@
-// Fabric: topology and rest state of grids and meshes (SCENARIOS.md "The cape").
+// Fabric: topology and rest state of grids and meshes (docs/SCENES.md "The cape").
 #include "CapeTestFixture.h"
 
 #include <map>

@@ -1,4 +1,4 @@
-// The SCENARIOS.md metrics as library code: strain, penetration, pin error, blow-up, the exact
+// The docs/SCENES.md metrics as library code: strain, penetration, pin error, blow-up, the exact
 // triangle-triangle test and the self-intersection count, and the run summary.
 #include "CapeTestFixture.h"
 

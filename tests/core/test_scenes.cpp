@@ -1,4 +1,4 @@
-// The canonical scenes of SCENARIOS.md on the simple body: the motions, and the quality bounds the solver
+// The canonical scenes of docs/SCENES.md on the simple body: the motions, and the quality bounds the solver
 // promises there (issue 2): walk strain median <= 3 %, p95 <= 5 %; sprint-turn penetration <= 1 mm.
 #include "CapeTestFixture.h"
 

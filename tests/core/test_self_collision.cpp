@@ -298,7 +298,7 @@ TEST(SelfCollision, ThicknessIsAutomaticOrAsSetAndBadValuesAreRejected) {
 }
 
 // Every canonical scene, 10 s (hang 5 s) on the 20 x 20 cape with self-collision on: not one pair of
-// triangles sharing no vertex intersects in any frame (the SCENARIOS.md metric), and nothing else breaks.
+// triangles sharing no vertex intersects in any frame (the docs/SCENES.md metric), and nothing else breaks.
 class SelfCollisionScenes : public ::testing::TestWithParam<SceneKind> {};
 
 TEST_P(SelfCollisionScenes, ZeroSelfIntersectionsInEveryFrame) {

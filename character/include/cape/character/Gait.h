@@ -3,13 +3,13 @@
 //
 // Root motion. The character frame (origin on the ground between the feet, facing -Z at yaw 0) follows the
 // canonical scenes exactly: for a scene, or for any gait that does not turn, it is the scenes' (cape::scenes)
-// cape::motionAt(MotionDesc, t) (shared/SCENARIOS.md: walk at 1.4 m/s, sprint-turn at 5 m/s with a 180 degree
+// cape::motionAt(MotionDesc, t) (docs/SCENES.md: walk at 1.4 m/s, sprint-turn at 5 m/s with a 180 degree
 // turn in the last 0.5 s of every 2 s), with the torso bob added to the root height, as the simple body does.
 // A gait with a constant turn rate w follows the exact arc: yaw = w t, and with forward = (-sin yaw, 0, -cos
 // yaw), position = (v/w (cos w t - 1), 0, -v/w sin w t).
 //
 // Joint angles, anatomical (see JointMapping.h), with phase p = 2 pi f t:
-//   hip       left  A sin p                        right  -A sin p   (SCENARIOS.md: A = 0.5236 rad)
+//   hip       left  A sin p                        right  -A sin p   (docs/SCENES.md: A = 0.5236 rad)
 //   knee      left  k0 + K max(0, cos p)^2         right  k0 + K max(0, -cos p)^2
 //             (the knee bends while its leg swings forward, most at mid-swing; C1-smooth)
 //   ankle     a (knee - hip): a = 1 keeps the foot level, a < 1 lets it follow the shin a little
@@ -33,7 +33,7 @@ struct GaitParams {
   double speed = 0.0;     ///< m/s along the heading
   double turnRate = 0.0;  ///< rad/s about world +Y (positive turns to the character's left)
   double stepFrequency =
-      0.0;  ///< Hz: full leg cycles per second (one left and one right step), SCENARIOS' "legs swing at"
+      0.0;  ///< Hz: full leg cycles per second (one left and one right step), docs/SCENES.md's "legs swing at"
   double bobAmplitude = 0.0;     ///< m, half the peak-to-peak torso bob (the whole body rises and falls)
   double bobFrequency = 0.0;     ///< Hz, usually 2 * stepFrequency (one bob per step)
   double hipAmplitude = 0.5236;  ///< rad, A above

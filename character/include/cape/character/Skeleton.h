@@ -1,4 +1,4 @@
-// Forward kinematics of a URDF model in the Y-up world of shared/SCENARIOS.md.
+// Forward kinematics of a URDF model in the Y-up world of docs/SCENES.md.
 //
 // Frames, from the world inwards:
 //   world (Y up, metres; the character faces -Z at yaw 0)

@@ -1,4 +1,4 @@
-// The quality metrics of shared/SCENARIOS.md as library code, so that tests, demos, benchmarks and
+// The quality metrics of docs/SCENES.md as library code, so that tests, demos, benchmarks and
 // comparisons measure exactly the same thing.
 #pragma once
 

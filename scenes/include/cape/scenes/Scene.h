@@ -1,4 +1,4 @@
-// The canonical scenes of shared/SCENARIOS.md on the simple body, with no Bullet: tests, benchmarks and the
+// The canonical scenes of docs/SCENES.md on the simple body, with no Bullet: tests, benchmarks and the
 // demos' --simple-body mode drive the solver exactly alike.
 #pragma once
 
@@ -54,7 +54,7 @@ struct BodyPose {
 /// Exact pose at time t (closed form, independent of the step size).
 BodyPose motionAt(const MotionDesc& motion, double t);
 
-/// The simple body of SCENARIOS.md: torso box, shoulder spheres, leg capsules and the ground plane.
+/// The simple body of docs/SCENES.md: torso box, shoulder spheres, leg capsules and the ground plane.
 /// Collider order: torso, left shoulder, right shoulder, left leg, right leg, ground.
 class SimpleBody {
  public:
