@@ -57,8 +57,8 @@ struct DeformableTwinSettings {
   bool shearLinks = true;       ///< Both diagonals of every cell.
   bool bendLinks = false;       ///< Every second particle along rows and columns.
   /// btDeformableMassSpringForce: Hooke stiffness of every link, N/m, and damping along the links, N s/m.
-  /// 50 N/m is about the stiffest the deformable world keeps finite with the 20 x 20 cape's 1 g nodes at
-  /// 1/240 s (100 N/m blows up, measured); the cape's own structural springs are 20000 N/m.
+  /// The default is about the stiffest the deformable world keeps finite with the canonical cape's light
+  /// nodes at 1/240 s, far softer than the cape's own structural springs (docs/COMPARISON.md, "Method").
   btScalar elasticStiffness = btScalar(50);
   btScalar dampingStiffness = btScalar(0.1);
   btScalar friction = btScalar(0.3);  ///< m_cfg.kDF.

@@ -46,8 +46,8 @@ struct CapeSettings {
   /// Linear velocity damping, 1/s: dv/dt = -damping * v (applied as v /= 1 + damping * h). Stands in for
   /// the air's drag when no aerodynamic wind model is on: a 0.4 kg, 0.6 m^2 cape moving at 1 m/s through
   /// still air feels about 0.5 rho Cd A v = 0.36 N, i.e. ~1 /s. The default 2 /s was chosen by measurement:
-  /// with 0.2 /s the walking cape swings around the torso and wraps its edges (p95 strain 19 %); with 2 /s
-  /// the p95 strain is 1.6 % (README, "Choosing the integrator").
+  /// with much less the walking cape swings around the torso and wraps its edges, and its strain climbs
+  /// (the sweep is in docs/SOLVER.md, "Choosing the integrator").
   float damping = 2.0f;
   /// Cape half-thickness kept between particles and collider surfaces, m.
   float collisionThickness = 0.01f;
@@ -55,13 +55,14 @@ struct CapeSettings {
   float friction = 0.3f;
   /// Substeps per `timeStep`, >= 1: step(dt) takes ceil(dt / (timeStep / substeps)) substeps of equal
   /// length, so a Bullet world stepping at 1/240 s takes one per internal step where a 1/60 s frame takes
-  /// three. Three per 1/60 s meet the walk scene's strain bounds (median 1.3 %, p95 2.1 %); see the README.
+  /// three. Three per 1/60 s meet the walk scene's strain bounds (docs/SOLVER.md, "Choosing the integrator").
   int substeps = 3;
   /// Strain-adaptive substepping: when the max structural strain after a step exceeds this (0 = off), the
   /// next steps take 2x, 4x ... up to maxRefinement times the substeps until it falls below half of it.
-  /// Meant for stiff cloth under violent motion (a sprint's 180-degree turn: p95 frame strain 60 % -> 10 %
-  /// for 2.7x the cost, walking unchanged); a deliberately stretchy cloth whose working strain is above the
-  /// limit would pay the full refinement for nothing: raise the limit or set 0.
+  /// Meant for stiff cloth under violent motion: it keeps a sprint's 180-degree turn from overstretching the
+  /// cape for a few times the cost and leaves walking unchanged (cost in docs/PERFORMANCE.md, strain in
+  /// docs/COMPARISON.md); a deliberately stretchy cloth whose working strain is above the limit would pay the
+  /// full refinement for nothing: raise the limit or set 0.
   float strainLimit = 0.05f;
   int maxRefinement = 4;  ///< >= 1
   /// Constraint iterations per substep, >= 1.
@@ -77,10 +78,10 @@ struct CapeSettings {
   /// the start of every step and kept on their side through its substeps (predictive contacts, Lewin 2018).
   bool selfCollision = false;
   /// Distance kept between a particle and any triangle it does not belong to, m; 0 (the default) chooses 0.35
-  /// of the mean particle spacing (1.3 cm on the canonical 20 x 20 cape). Measured on the 20 x 20 cape: at
-  /// 5 mm the sprint-turn still had 24 intersecting triangle pairs in its worst frame (two layers crossing
-  /// edge through edge between their particles); from about a third of the spacing none, in every scene.
-  /// Keep it well under the spacing, or neighbours of the same layer push each other.
+  /// of the mean particle spacing. Measured on the canonical cape: much thinner, the sprint-turn still has
+  /// intersecting triangle pairs (two layers crossing edge through edge between their particles); from about
+  /// a third of the spacing none, in every scene (docs/SOLVER.md, "Self-collision"). Keep it well under the
+  /// spacing, or neighbours of the same layer push each other.
   float selfCollisionThickness = 0.0f;
 
   /// The Unity seed's explicit solver reproduced: explicit springs, soft, 4 substeps of 0.00875 s per 0.035 s
