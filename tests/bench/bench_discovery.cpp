@@ -1,5 +1,5 @@
 // Google Benchmark over collider discovery and the removed-body check against the size of the world (issue
-// 12). One walking cape (SCENARIOS.md's walk on kinematic Bullet bodies: torso, shoulders and legs moved
+// 12). One walking cape (docs/SCENES.md's walk on kinematic Bullet bodies: torso, shoulders and legs moved
 // with the character frame, the cape pinned by its corners to the shoulder spheres, over the ground plane)
 // in a Bullet world that also holds N small static boxes far away (a grid at x >= 60 m while the character
 // walks along -Z from the origin: never near the cape, never discovered). One iteration is one frame,
