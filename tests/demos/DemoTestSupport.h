@@ -8,6 +8,7 @@
 #include <fstream>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 #include <vector>
 
 namespace cape::demo_test {
@@ -30,10 +31,12 @@ inline Result run(const std::string& command) {
   return r;
 }
 
-/// A fresh, empty folder under the build's temporary directory, named after the running test.
+/// A fresh, empty folder under the temporary directory, named after the running test and this process (two
+/// test runs at once on one machine must not share it).
 inline std::filesystem::path freshDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::filesystem::path dir = std::filesystem::temp_directory_path() / "cape_demo_tests" /
+  std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                              ("cape_demo_tests-" + std::to_string(::getpid())) /
                               (std::string(info->test_suite_name()) + "." + info->name());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
