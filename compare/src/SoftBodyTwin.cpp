@@ -16,8 +16,8 @@ namespace {
 
 /// A btSoftBody with the cape's particles as nodes (positions now, masses), a link for every spring of the
 /// wanted families at the fabric's rest length, and the fabric's triangles as faces.
-std::unique_ptr<btSoftBody> makeTwinBody(btSoftBodyWorldInfo& info, const CapeAction& cape, btScalar linearStiffness,
-                                         const bool (&wanted)[kSpringFamilyCount]) {
+std::unique_ptr<btSoftBody> makeTwinBody(btSoftBodyWorldInfo& info, const CapeAction& cape,
+                                         btScalar linearStiffness, const bool (&wanted)[kSpringFamilyCount]) {
   const Fabric& fabric = cape.cape().fabric();
   const int n = static_cast<int>(fabric.particleCount());
   std::vector<btVector3> x(static_cast<std::size_t>(n));
@@ -56,7 +56,8 @@ std::unique_ptr<btSoftBody> makeSoftBodyTwin(btSoftRigidDynamicsWorld& world, co
                                              const SoftBodyTwinSettings& settings) {
   if (!cape.ok()) return nullptr;
   const bool wanted[kSpringFamilyCount] = {settings.structuralLinks, settings.shearLinks, settings.bendLinks};
-  std::unique_ptr<btSoftBody> body = makeTwinBody(world.getWorldInfo(), cape, settings.linearStiffness, wanted);
+  std::unique_ptr<btSoftBody> body =
+      makeTwinBody(world.getWorldInfo(), cape, settings.linearStiffness, wanted);
 
   btSoftBody::Config& cfg = body->m_cfg;
   cfg.piterations = settings.positionIterations;
@@ -88,7 +89,8 @@ DeformableTwin::~DeformableTwin() {
   world_.removeSoftBody(body_.get());
 }
 
-std::unique_ptr<DeformableTwin> makeDeformableTwin(btDeformableMultiBodyDynamicsWorld& world, const CapeAction& cape,
+std::unique_ptr<DeformableTwin> makeDeformableTwin(btDeformableMultiBodyDynamicsWorld& world,
+                                                   const CapeAction& cape,
                                                    const DeformableTwinSettings& settings) {
   if (!cape.ok()) return nullptr;
   const bool wanted[kSpringFamilyCount] = {settings.structuralLinks, settings.shearLinks, settings.bendLinks};
@@ -104,7 +106,8 @@ std::unique_ptr<DeformableTwin> makeDeformableTwin(btDeformableMultiBodyDynamics
   world.addSoftBody(body.get(), settings.collisionGroup, settings.collisionMask);
 
   std::vector<std::unique_ptr<btDeformableLagrangianForce>> forces;
-  forces.push_back(std::make_unique<btDeformableMassSpringForce>(settings.elasticStiffness, settings.dampingStiffness, true));
+  forces.push_back(std::make_unique<btDeformableMassSpringForce>(settings.elasticStiffness,
+                                                                 settings.dampingStiffness, true));
   forces.push_back(std::make_unique<btDeformableGravityForce>(world.getWorldInfo().m_gravity));
   for (auto& f : forces) world.addForce(body.get(), f.get());
   // A deformable anchor holds its node at the body-frame point where the node is when it is appended: the

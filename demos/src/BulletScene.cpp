@@ -48,7 +48,8 @@ struct BulletScene::Character {
   std::vector<PinSpec> pins;
 };
 
-std::unique_ptr<BulletScene> BulletScene::create(const RunOptions& options, std::string& error, WorldKind kind) {
+std::unique_ptr<BulletScene> BulletScene::create(const RunOptions& options, std::string& error,
+                                                 WorldKind kind) {
   std::unique_ptr<BulletScene> scene(new BulletScene());
   if (!scene->build(options, kind, error)) return nullptr;
   return scene;
@@ -76,8 +77,8 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
     deformableSolver_ = std::make_unique<btDeformableBodySolver>();
     auto solver = std::make_unique<btDeformableMultiBodyConstraintSolver>();
     solver->setDeformableSolver(deformableSolver_.get());
-    auto world = std::make_unique<btDeformableMultiBodyDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver.get(),
-                                                                      configuration_.get(), deformableSolver_.get());
+    auto world = std::make_unique<btDeformableMultiBodyDynamicsWorld>(
+        dispatcher_.get(), broadphase_.get(), solver.get(), configuration_.get(), deformableSolver_.get());
     // Explicit steps, as Bullet's own cloth demos: on this cape the implicit mode either leaves the nodes
     // where they are (its default Lagrange multipliers) or blows up (with projection), measured. Contacts
     // read the world's sparse signed-distance field, set up as those demos do.
@@ -89,8 +90,8 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
     world_ = std::move(world);
   } else {
     solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-    auto world = std::make_unique<btSoftRigidDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
-                                                            configuration_.get());
+    auto world = std::make_unique<btSoftRigidDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
+                                                            solver_.get(), configuration_.get());
     softRigidWorld_ = world.get();
     info = &world->getWorldInfo();
     world_ = std::move(world);
@@ -119,7 +120,8 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
     // The links the cape pins to: as asked, or every link named like a shoulder.
     attachLinks_ = o.attachLinks.empty() ? model->linksContaining("shoulder") : o.attachLinks;
     if (attachLinks_.empty()) {
-      error = "no link named like \"shoulder\" in " + (o.urdf.empty() ? std::string("the humanoid") : o.urdf) +
+      error = "no link named like \"shoulder\" in " +
+              (o.urdf.empty() ? std::string("the humanoid") : o.urdf) +
               ": name the links to attach to with --attach LINK[,LINK]";
       return false;
     }
@@ -131,7 +133,8 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
         return false;
       }
     }
-    body_ = (o.urdf.empty() ? std::string("the shipped humanoid (character/models/humanoid.urdf)") : "URDF " + o.urdf);
+    body_ = (o.urdf.empty() ? std::string("the shipped humanoid (character/models/humanoid.urdf)")
+                            : "URDF " + o.urdf);
   } else {
     body_ = "the simple body of docs/SCENES.md as kinematic Bullet bodies";
   }
@@ -189,9 +192,10 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
     c->placement.rotation = start.rotation;
     for (std::size_t p = 0; p < rig_.pinnedParticles.size(); ++p) {
       const Vec3 point = rig_.pinLocalPoints[p] + shift;
-      const auto nearest = std::min_element(anchors.begin(), anchors.end(), [&](const auto& a, const auto& b) {
-        return std::fabs(a.first - point.x()) < std::fabs(b.first - point.x());
-      });
+      const auto nearest =
+          std::min_element(anchors.begin(), anchors.end(), [&](const auto& a, const auto& b) {
+            return std::fabs(a.first - point.x()) < std::fabs(b.first - point.x());
+          });
       btRigidBody* body = nearest->second;
       c->pins.push_back({rig_.pinnedParticles[p], body, body->getWorldTransform().inverse() * toBt(point)});
     }
@@ -229,10 +233,15 @@ std::vector<Collider> BulletScene::bodyColliders(int k) const {
     const Pose pose = poseOf(w.pose);
     Collider col;
     switch (w.shape->type) {
-      case character::ShapeType::Sphere: col = Collider::sphere(static_cast<float>(w.shape->radius), pose); break;
-      case character::ShapeType::Box: col = Collider::box(w.shape->halfExtents.cast<float>(), pose); break;
+      case character::ShapeType::Sphere:
+        col = Collider::sphere(static_cast<float>(w.shape->radius), pose);
+        break;
+      case character::ShapeType::Box:
+        col = Collider::box(w.shape->halfExtents.cast<float>(), pose);
+        break;
       case character::ShapeType::Cylinder:
-        col = Collider::cylinder(static_cast<float>(w.shape->radius), static_cast<float>(w.shape->halfLength), 2, pose);
+        col = Collider::cylinder(static_cast<float>(w.shape->radius), static_cast<float>(w.shape->halfLength),
+                                 2, pose);
         break;
     }
     col.name = w.shape->name.empty() ? *w.linkName : w.shape->name;
@@ -247,9 +256,13 @@ Vec3 BulletScene::torsoCentre(int k) const {
   return c.urdf->skeleton().linkPose(c.torsoLink).translation().cast<float>();
 }
 
-Pose BulletScene::capePlacement(int k) const { return characters_[static_cast<std::size_t>(k)]->placement; }
+Pose BulletScene::capePlacement(int k) const {
+  return characters_[static_cast<std::size_t>(k)]->placement;
+}
 
-const std::vector<PinSpec>& BulletScene::pins(int k) const { return characters_[static_cast<std::size_t>(k)]->pins; }
+const std::vector<PinSpec>& BulletScene::pins(int k) const {
+  return characters_[static_cast<std::size_t>(k)]->pins;
+}
 
 std::string BulletScene::describe() const {
   std::string links;

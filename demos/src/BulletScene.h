@@ -30,8 +30,8 @@ struct PinSpec {
 };
 
 /// Which Bullet world the scene lives in: the soft-rigid world of btSoftBody (the default; our cape and
-/// the btSoftBody twin), or Bullet's deformable world (deformable bodies with Lagrangian forces, multibodies),
-/// where cape_compare puts the deformable twin.
+/// the btSoftBody twin), or Bullet's deformable world (deformable bodies with Lagrangian forces,
+/// multibodies), where cape_compare puts the deformable twin.
 enum class WorldKind { SoftRigid, Deformable };
 
 class BulletScene {
@@ -87,7 +87,7 @@ class BulletScene {
   std::unique_ptr<btDeformableBodySolver> deformableSolver_;  ///< Deformable worlds only.
   std::unique_ptr<btConstraintSolver> solver_;
   std::unique_ptr<btDiscreteDynamicsWorld> world_;
-  btSoftRigidDynamicsWorld* softRigidWorld_ = nullptr;            ///< world_, when it is one
+  btSoftRigidDynamicsWorld* softRigidWorld_ = nullptr;             ///< world_, when it is one
   btDeformableMultiBodyDynamicsWorld* deformableWorld_ = nullptr;  ///< world_, when it is one
   std::unique_ptr<btStaticPlaneShape> groundShape_;
   std::unique_ptr<btRigidBody> ground_;

@@ -1,13 +1,16 @@
 #include "Progress.h"
 
-#include <cstdio>
 #include <unistd.h>
+#include <cstdio>
 
 namespace cape::demo {
 
 Progress::Progress(std::string label, long total)
-    : label_(std::move(label)), total_(total > 0 ? total : 1), start_(std::chrono::steady_clock::now()),
-      lastDraw_(start_), tty_(isatty(STDERR_FILENO) != 0) {}
+    : label_(std::move(label)),
+      total_(total > 0 ? total : 1),
+      start_(std::chrono::steady_clock::now()),
+      lastDraw_(start_),
+      tty_(isatty(STDERR_FILENO) != 0) {}
 
 void Progress::update(long done) {
   const auto now = std::chrono::steady_clock::now();
@@ -20,8 +23,8 @@ void Progress::update(long done) {
     constexpr int kWidth = 30;
     const int filled = static_cast<int>(fraction * kWidth);
     std::fprintf(stderr, "\r%s [%.*s%*s] %3d%%  %ld/%ld  %.0fs left ", label_.c_str(), filled,
-                 "##############################", kWidth - filled, "", static_cast<int>(fraction * 100.0), done, total_,
-                 eta);
+                 "##############################", kWidth - filled, "", static_cast<int>(fraction * 100.0),
+                 done, total_, eta);
   } else {
     const int decile = static_cast<int>(fraction * 10.0);
     if (decile == lastDecile_) return;

@@ -13,7 +13,6 @@
 #include <cstdio>
 #include <cstdlib>
 
-
 namespace cape::demo {
 
 namespace fs = std::filesystem;

@@ -10,18 +10,26 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
-const char* axisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
+json vec(const Vec3& v) {
+  return json::array({v.x(), v.y(), v.z()});
+}
+const char* axisName(int axis) {
+  return axis == 0 ? "x" : axis == 1 ? "y" : "z";
+}
 }  // namespace
 
 json settingsJson(const CapeSettings& s) {
   json wind = {{"model", s.wind.model == WindSettings::Model::None       ? "none"
                          : s.wind.model == WindSettings::Model::SineWave ? "sine-wave"
-                                                                          : "aerodynamic"}};
+                                                                         : "aerodynamic"}};
   if (s.wind.model != WindSettings::Model::None)
-    wind.update({{"direction", vec(s.wind.direction)}, {"speed_mps", s.wind.speed}, {"gust_amplitude", s.wind.gustAmplitude},
-                 {"gust_frequency_hz", s.wind.gustFrequency}, {"turbulence_scale_m", s.wind.turbulenceScale},
-                 {"drag_coefficient", s.wind.dragCoefficient}, {"lift_coefficient", s.wind.liftCoefficient},
+    wind.update({{"direction", vec(s.wind.direction)},
+                 {"speed_mps", s.wind.speed},
+                 {"gust_amplitude", s.wind.gustAmplitude},
+                 {"gust_frequency_hz", s.wind.gustFrequency},
+                 {"turbulence_scale_m", s.wind.turbulenceScale},
+                 {"drag_coefficient", s.wind.dragCoefficient},
+                 {"lift_coefficient", s.wind.liftCoefficient},
                  {"seed", s.wind.seed}});
   return {{"integrator", toString(s.integrator)},
           {"structural_stiffness_n_per_m", s.structuralStiffness},
@@ -74,7 +82,8 @@ json colliderJson(const Collider& c) {
       // on the face), enough to recompute a particle's penetration from the files alone.
       json vertices = json::array(), planes = json::array();
       for (const Vec3& v : c.hull->vertices) vertices.push_back(vec(v));
-      for (const Eigen::Vector4f& q : c.hull->planes) planes.push_back({{"normal", vec(q.head<3>())}, {"offset", q[3]}});
+      for (const Eigen::Vector4f& q : c.hull->planes)
+        planes.push_back({{"normal", vec(q.head<3>())}, {"offset", q[3]}});
       j["vertices"] = std::move(vertices);
       j["planes"] = std::move(planes);
       break;
@@ -99,7 +108,8 @@ void writeObj(const fs::path& file, const CapeMesh& mesh, std::size_t n) {
     const auto r = mesh.normals.row(static_cast<Eigen::Index>(i));
     std::fprintf(f, "vn %.5f %.5f %.5f\n", r.x(), r.y(), r.z());
   }
-  for (std::size_t i = 0; i < n; ++i) std::fprintf(f, "vt %.6f %.6f\n", mesh.uvs[i].x(), 1.0f - mesh.uvs[i].y());
+  for (std::size_t i = 0; i < n; ++i)
+    std::fprintf(f, "vt %.6f %.6f\n", mesh.uvs[i].x(), 1.0f - mesh.uvs[i].y());
   for (std::size_t t = 0; t + 2 < mesh.indices.size() && mesh.indices[t] < n; t += 3) {
     const unsigned a = mesh.indices[t] + 1, b = mesh.indices[t + 1] + 1, c = mesh.indices[t + 2] + 1;
     std::fprintf(f, "f %u/%u/%u %u/%u/%u %u/%u/%u\n", a, a, a, b, b, b, c, c, c);
@@ -114,7 +124,8 @@ RunWriter::RunWriter(const fs::path& dir, bool writeFrames, int characters)
   if (ec) throw std::runtime_error("cannot create output folder " + dir_.string() + ": " + ec.message());
   if (writeFrames_) {
     if (characters_ > 1) {
-      for (int k = 0; k < characters_; ++k) fs::create_directories(dir_ / "frames" / ("k" + std::to_string(k)), ec);
+      for (int k = 0; k < characters_; ++k)
+        fs::create_directories(dir_ / "frames" / ("k" + std::to_string(k)), ec);
     } else {
       fs::create_directories(dir_ / "frames", ec);
     }
@@ -123,25 +134,29 @@ RunWriter::RunWriter(const fs::path& dir, bool writeFrames, int characters)
   csv_.open(dir_ / "metrics.csv");
   jsonl_.open(dir_ / "colliders.jsonl");
   if (!csv_ || !jsonl_) throw std::runtime_error("cannot write into " + dir_.string());
-  csv_ << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_intersections,"
+  csv_ << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_"
+          "intersections,"
           "pin_error_m,mean_speed_mps,blow_up\n";
 }
 
 void RunWriter::frame(const FrameRow& r) {
   char line[512];
-  std::snprintf(line, sizeof line, "%d,%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%.5f,%d\n", r.frame, r.time, r.frameTimeUs,
-                r.capeTimeUs, r.metrics.maxStrain, r.metrics.meanStrain, r.metrics.maxPenetration,
-                r.metrics.selfIntersections, r.metrics.pinError, r.metrics.meanSpeed, r.metrics.blowUp ? 1 : 0);
+  std::snprintf(line, sizeof line, "%d,%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%.5f,%d\n", r.frame, r.time,
+                r.frameTimeUs, r.capeTimeUs, r.metrics.maxStrain, r.metrics.meanStrain,
+                r.metrics.maxPenetration, r.metrics.selfIntersections, r.metrics.pinError,
+                r.metrics.meanSpeed, r.metrics.blowUp ? 1 : 0);
   csv_ << line;
 }
 
 void RunWriter::capeMesh(int frame, int character, const Cape& cape) {
   if (!writeFrames_) return;
-  if (mesh_.positions.rows() != static_cast<Eigen::Index>(cape.fabric().particleCount())) mesh_.allocate(cape.fabric(), false);
+  if (mesh_.positions.rows() != static_cast<Eigen::Index>(cape.fabric().particleCount()))
+    mesh_.allocate(cape.fabric(), false);
   mesh_.update(cape.fabric(), cape.state().positions);
   char name[32];
   std::snprintf(name, sizeof name, "%05d.obj", frame);
-  const fs::path folder = characters_ > 1 ? dir_ / "frames" / ("k" + std::to_string(character)) : dir_ / "frames";
+  const fs::path folder =
+      characters_ > 1 ? dir_ / "frames" / ("k" + std::to_string(character)) : dir_ / "frames";
   writeObj(folder / name, mesh_, cape.fabric().particleCount());
 }
 

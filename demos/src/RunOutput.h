@@ -20,9 +20,9 @@ namespace cape::demo {
 /// One row of metrics.csv (for a crowd: the worst over its characters).
 struct FrameRow {
   int frame = 0;
-  double time = 0.0;        ///< s, at the end of the frame
-  double frameTimeUs = 0.0; ///< wall time of the whole frame step
-  double capeTimeUs = 0.0;  ///< the cape solver's share
+  double time = 0.0;         ///< s, at the end of the frame
+  double frameTimeUs = 0.0;  ///< wall time of the whole frame step
+  double capeTimeUs = 0.0;   ///< the cape solver's share
   FrameMetrics metrics;
 };
 

@@ -21,7 +21,7 @@ struct RunOptions {
   int threads = 1;
   CapeSettings settings;
   bool simpleBody = false;
-  std::string urdf;                   ///< empty: the shipped humanoid
+  std::string urdf;                      ///< empty: the shipped humanoid
   std::vector<std::string> attachLinks;  ///< empty: found by name ("shoulder")
 };
 

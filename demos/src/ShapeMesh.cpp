@@ -92,14 +92,16 @@ void hullFaces(const ConvexHull& hull, ShapeMesh& mesh) {
     for (const Vec3& v : face) centre += v / static_cast<float>(face.size());
     const Vec3 t = (face[0] - centre).normalized(), b = n.cross(t);
     std::sort(face.begin(), face.end(), [&](const Vec3& u, const Vec3& v) {
-      return std::atan2((u - centre).dot(b), (u - centre).dot(t)) < std::atan2((v - centre).dot(b), (v - centre).dot(t));
+      return std::atan2((u - centre).dot(b), (u - centre).dot(t)) <
+             std::atan2((v - centre).dot(b), (v - centre).dot(t));
     });
     const auto first = static_cast<std::uint32_t>(mesh.positions.size() / 3);
     for (const Vec3& v : face) {
       mesh.positions.insert(mesh.positions.end(), {v.x(), v.y(), v.z()});
       mesh.normals.insert(mesh.normals.end(), {n.x(), n.y(), n.z()});
     }
-    for (std::uint32_t k = 1; k + 1 < face.size(); ++k) mesh.indices.insert(mesh.indices.end(), {first, first + k, first + k + 1});
+    for (std::uint32_t k = 1; k + 1 < face.size(); ++k)
+      mesh.indices.insert(mesh.indices.end(), {first, first + k, first + k + 1});
   }
 }
 

@@ -44,12 +44,14 @@ class TwinRun {
 
   bool build(const RunOptions& o, Kind kind, const compare::SoftBodyTwinSettings& soft,
              const compare::DeformableTwinSettings& deformable, std::string& error) {
-    scene_ = BulletScene::create(o, error, kind == Kind::Deformable ? WorldKind::Deformable : WorldKind::SoftRigid);
+    scene_ = BulletScene::create(o, error,
+                                 kind == Kind::Deformable ? WorldKind::Deformable : WorldKind::SoftRigid);
     if (!scene_) return false;
     const CapeSettings settings = settingsForScene(o.scene, o.settings);
     for (int k = 0; k < scene_->characterCount(); ++k) {
       // A cape action (never added to the world) places the cape and holds the attachments the twin copies.
-      auto proto = std::make_unique<bullet::CapeAction>(scene_->rig().fabric, settings, bullet::toBt(scene_->capePlacement(k)));
+      auto proto = std::make_unique<bullet::CapeAction>(scene_->rig().fabric, settings,
+                                                        bullet::toBt(scene_->capePlacement(k)));
       for (const PinSpec& p : scene_->pins(k)) proto->attach(p.particle, p.body, p.localPivot);
       btSoftBody* body = nullptr;
       if (kind == Kind::SoftBody) {
@@ -64,7 +66,8 @@ class TwinRun {
         body = made.get();
         if (made) softBodies_.push_back(std::move(made));
       } else {
-        std::unique_ptr<compare::DeformableTwin> made = compare::makeDeformableTwin(*scene_->deformableWorld(), *proto, deformable);
+        std::unique_ptr<compare::DeformableTwin> made =
+            compare::makeDeformableTwin(*scene_->deformableWorld(), *proto, deformable);
         body = made ? &made->body() : nullptr;
         if (made) deformables_.push_back(std::move(made));
       }
@@ -104,7 +107,8 @@ class TwinRun {
       pins_[c][p].target = bullet::toVec3(specs[p].body->getWorldTransform() * specs[p].localPivot);
     }
     const Fabric& fabric = *scene_->rig().fabric;  // built (or build() failed) with the scene
-    return measureFrame(fabric, x, v, pins_[c], scene_->bodyColliders(k), scene_->torsoCentre(k), &counters_[c]);
+    return measureFrame(fabric, x, v, pins_[c], scene_->bodyColliders(k), scene_->torsoCentre(k),
+                        &counters_[c]);
   }
   int characterCount() const { return scene_->characterCount(); }
   const Fabric& fabric() const { return *scene_->rig().fabric; }
@@ -124,26 +128,40 @@ class TwinRun {
 };
 
 json twinSettingsJson(const compare::SoftBodyTwinSettings& t) {
-  return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") + (t.bendLinks ? "bend" : "")},
-          {"piterations", t.positionIterations}, {"viterations", t.velocityIterations},
-          {"diterations", t.driftIterations}, {"kLST", t.linearStiffness}, {"kDP", t.damping},
-          {"kDF", t.friction}, {"kAHR", t.anchorHardness}, {"kCHR", t.rigidContactHardness},
-          {"margin_m", t.margin}, {"collisions", "SDF_RS"}};
+  return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") +
+                        (t.bendLinks ? "bend" : "")},
+          {"piterations", t.positionIterations},
+          {"viterations", t.velocityIterations},
+          {"diterations", t.driftIterations},
+          {"kLST", t.linearStiffness},
+          {"kDP", t.damping},
+          {"kDF", t.friction},
+          {"kAHR", t.anchorHardness},
+          {"kCHR", t.rigidContactHardness},
+          {"margin_m", t.margin},
+          {"collisions", "SDF_RS"}};
 }
 
 json deformableSettingsJson(const compare::DeformableTwinSettings& t) {
-  return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") + (t.bendLinks ? "bend" : "")},
+  return {{"links", std::string(t.structuralLinks ? "structural " : "") + (t.shearLinks ? "shear " : "") +
+                        (t.bendLinks ? "bend" : "")},
           {"world", "btDeformableMultiBodyDynamicsWorld, explicit"},
-          {"elastic_stiffness_N_per_m", t.elasticStiffness}, {"damping_stiffness_Ns_per_m", t.dampingStiffness},
-          {"kDF", t.friction}, {"margin_m", t.margin}, {"collisions", "SDF_RD | SDF_RDF"}, {"wind", "none"}};
+          {"elastic_stiffness_N_per_m", t.elasticStiffness},
+          {"damping_stiffness_Ns_per_m", t.dampingStiffness},
+          {"kDF", t.friction},
+          {"margin_m", t.margin},
+          {"collisions", "SDF_RD | SDF_RDF"},
+          {"wind", "none"}};
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"cape_compare: the same scene with our cape and with Bullet's btSoftBody twin (and, with "
-               "--with-deformable, its deformable-world twin), side by side; prints every metric of docs/SCENES.md per "
-               "solver and writes compare.csv, compare.json and PNG plots."};
+  CLI::App app{
+      "cape_compare: the same scene with our cape and with Bullet's btSoftBody twin (and, with "
+      "--with-deformable, its deformable-world twin), side by side; prints every metric of docs/SCENES.md "
+      "per "
+      "solver and writes compare.csv, compare.json and PNG plots."};
   SceneCli sceneCli;
   std::string out;
   int iterations = 10;
@@ -163,9 +181,10 @@ int main(int argc, char** argv) {
                  "the deformable twin's spring stiffness, N/m (from 100 it blows up on the 20 x 20 cape)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--render", render,
-                 "also render both capes side by side (ours left, btSoftBody right) as PNG frames, and run.mp4 and "
-                 "run.gif with ffmpeg, into this folder");
+  app.add_option(
+      "--render", render,
+      "also render both capes side by side (ours left, btSoftBody right) as PNG frames, and run.mp4 and "
+      "run.gif with ffmpeg, into this folder");
   app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
@@ -209,7 +228,8 @@ int main(int argc, char** argv) {
   std::unique_ptr<BulletScene> bare[2];
   for (int i = 0; i < twinCount; ++i) {
     const TwinRun::Kind kind = i == 0 ? TwinRun::Kind::SoftBody : TwinRun::Kind::Deformable;
-    bare[i] = BulletScene::create(o, error, kind == TwinRun::Kind::Deformable ? WorldKind::Deformable : WorldKind::SoftRigid);
+    bare[i] = BulletScene::create(
+        o, error, kind == TwinRun::Kind::Deformable ? WorldKind::Deformable : WorldKind::SoftRigid);
     if (!bare[i] || !twinRuns[i].build(o, kind, twin, deformable, error)) {
       std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
       return 1;
@@ -217,7 +237,8 @@ int main(int argc, char** argv) {
   }
   TwinRun& twinRun = twinRuns[0];
 
-  const std::filesystem::path dir = out.empty() ? freshRunFolder(scene, "cape_compare") : std::filesystem::path(out);
+  const std::filesystem::path dir =
+      out.empty() ? freshRunFolder(scene, "cape_compare") : std::filesystem::path(out);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) {
@@ -262,8 +283,8 @@ int main(int argc, char** argv) {
     FrameRow a{f, t, ours->lastFrameTimeUs(), ours->lastCapeTimeUs(), {}};
     // A crowd's row holds the worst of its characters.
     for (int k = 0; k < ours->characterCount(); ++k) {
-      const FrameMetrics m =
-          measureFrame(ours->cape(k), ours->bodyColliders(k), ours->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
+      const FrameMetrics m = measureFrame(ours->cape(k), ours->bodyColliders(k), ours->torsoCentre(k),
+                                          &counters[static_cast<std::size_t>(k)]);
       a.metrics = k == 0 ? m : worstOf(a.metrics, m);
     }
     results[0].rows.push_back(a);
@@ -298,13 +319,15 @@ int main(int argc, char** argv) {
   const json ourSummary = summaryFigures(results[0].rows, results[0].recorder.summary());
   const double ourCape = ourSummary["cape_time_us_median"].get<double>();
   std::ofstream csv(dir / "compare.csv");
-  csv << "solver,frame_time_us_median,cape_time_us_median,cape_time_us_p95,cape_time_ratio_to_ours,max_strain,"
-         "mean_strain,p95_frame_max_strain,max_penetration_m,frames_penetration_over_1mm,self_intersections_max,"
+  csv << "solver,frame_time_us_median,cape_time_us_median,cape_time_us_p95,cape_time_ratio_to_ours,max_"
+         "strain,"
+         "mean_strain,p95_frame_max_strain,max_penetration_m,frames_penetration_over_1mm,self_intersections_"
+         "max,"
          "pin_error_max_m,blow_up\n";
-  std::printf("cape_compare: scene %s, %d x %d cape, %d frames -> %s\n%s\n", scene.c_str(), size, size, frames,
-              dir.c_str(), ours->describe().c_str());
-  std::printf("%-18s %9s %9s %9s %7s %8s %8s %9s %6s %6s %9s %6s\n", "solver", "frame us", "cape us", "cape p95",
-              "x ours", "strain", "mean", "pen m", ">1mm", "self", "pin m", "blowup");
+  std::printf("cape_compare: scene %s, %d x %d cape, %d frames -> %s\n%s\n", scene.c_str(), size, size,
+              frames, dir.c_str(), ours->describe().c_str());
+  std::printf("%-18s %9s %9s %9s %7s %8s %8s %9s %6s %6s %9s %6s\n", "solver", "frame us", "cape us",
+              "cape p95", "x ours", "strain", "mean", "pen m", ">1mm", "self", "pin m", "blowup");
   for (SolverResult& r : results) {
     const RunSummary q = r.recorder.summary();
     json s = summaryFigures(r.rows, q);
@@ -325,10 +348,11 @@ int main(int argc, char** argv) {
                 {"settings", r.settings}};
     compare["solvers"].push_back(row);
     char line[512];
-    std::snprintf(line, sizeof line, "%s,%.2f,%.2f,%.2f,%.3f,%.6f,%.6f,%.6f,%.6f,%d,%d,%.3g,%d\n", r.name.c_str(),
-                  s["frame_time_us_median"].get<double>(), s["cape_time_us_median"].get<double>(),
-                  s["cape_time_us_p95"].get<double>(), ratio, q.maxStrain, q.meanStrain, q.p95FrameMaxStrain,
-                  q.maxPenetration, q.framesPenetrationOver1mm, q.selfIntersectionsMax, q.pinErrorMax, q.blowUp ? 1 : 0);
+    std::snprintf(line, sizeof line, "%s,%.2f,%.2f,%.2f,%.3f,%.6f,%.6f,%.6f,%.6f,%d,%d,%.3g,%d\n",
+                  r.name.c_str(), s["frame_time_us_median"].get<double>(),
+                  s["cape_time_us_median"].get<double>(), s["cape_time_us_p95"].get<double>(), ratio,
+                  q.maxStrain, q.meanStrain, q.p95FrameMaxStrain, q.maxPenetration,
+                  q.framesPenetrationOver1mm, q.selfIntersectionsMax, q.pinErrorMax, q.blowUp ? 1 : 0);
     csv << line;
     std::printf("%-18s %9.1f %9.1f %9.1f %7.2f %7.2f%% %7.3f%% %9.4f %6d %6d %9.2g %6s\n", r.name.c_str(),
                 s["frame_time_us_median"].get<double>(), s["cape_time_us_median"].get<double>(),
@@ -336,13 +360,17 @@ int main(int argc, char** argv) {
                 q.maxPenetration, q.framesPenetrationOver1mm, q.selfIntersectionsMax, q.pinErrorMax,
                 q.blowUp ? "YES" : "no");
     // Per-frame rows of each solver.
-    const char* perFrameName = &r == &results[0] ? "frames_ours" : &r == &results[1] ? "frames_btsoftbody" : "frames_deformable";
+    const char* perFrameName = &r == &results[0]   ? "frames_ours"
+                               : &r == &results[1] ? "frames_btsoftbody"
+                                                   : "frames_deformable";
     std::ofstream perFrame(dir / (std::string(perFrameName) + ".csv"));
-    perFrame << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_intersections,pin_error_m,blow_up\n";
+    perFrame << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_"
+                "intersections,pin_error_m,blow_up\n";
     for (const FrameRow& fr : r.rows) {
-      std::snprintf(line, sizeof line, "%d,%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%d\n", fr.frame, fr.time, fr.frameTimeUs,
-                    fr.capeTimeUs, fr.metrics.maxStrain, fr.metrics.meanStrain, fr.metrics.maxPenetration,
-                    fr.metrics.selfIntersections, fr.metrics.pinError, fr.metrics.blowUp ? 1 : 0);
+      std::snprintf(line, sizeof line, "%d,%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%d\n", fr.frame, fr.time,
+                    fr.frameTimeUs, fr.capeTimeUs, fr.metrics.maxStrain, fr.metrics.meanStrain,
+                    fr.metrics.maxPenetration, fr.metrics.selfIntersections, fr.metrics.pinError,
+                    fr.metrics.blowUp ? 1 : 0);
       perFrame << line;
     }
   }
@@ -372,10 +400,12 @@ int main(int argc, char** argv) {
       return out;
     };
     const bool drawn =
-        plotLines(dir / "strain.png", "Max structural strain per frame (" + scene + ")", "time, s", "strain, %",
-                  series([](const FrameRow& r) { return 100.0 * r.metrics.maxStrain; }), error) &&
-        plotLines(dir / "penetration.png", "Deepest particle inside a body collider (" + scene + ")", "time, s",
-                  "penetration, mm", series([](const FrameRow& r) { return 1000.0 * r.metrics.maxPenetration; }), error) &&
+        plotLines(dir / "strain.png", "Max structural strain per frame (" + scene + ")", "time, s",
+                  "strain, %", series([](const FrameRow& r) { return 100.0 * r.metrics.maxStrain; }),
+                  error) &&
+        plotLines(dir / "penetration.png", "Deepest particle inside a body collider (" + scene + ")",
+                  "time, s", "penetration, mm",
+                  series([](const FrameRow& r) { return 1000.0 * r.metrics.maxPenetration; }), error) &&
         plotLines(dir / "frame_time.png", "Wall time of stepSimulation per frame (" + scene + ")", "time, s",
                   "frame time, us", series([](const FrameRow& r) { return r.frameTimeUs; }), error);
     if (!drawn) std::fprintf(stderr, "cape_compare: plots not drawn: %s\n", error.c_str());

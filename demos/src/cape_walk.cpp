@@ -10,8 +10,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include <cmath>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -20,14 +20,12 @@
 using namespace cape;
 using namespace cape::demo;
 
-namespace {
-
-
-}  // namespace
+namespace {}  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"cape_walk: a character walks headlessly with a cape; writes metrics.csv, summary.json, "
-               "frames/NNNNN.obj and colliders.jsonl to an output folder."};
+  CLI::App app{
+      "cape_walk: a character walks headlessly with a cape; writes metrics.csv, summary.json, "
+      "frames/NNNNN.obj and colliders.jsonl to an output folder."};
   SceneCli sceneCli;
   std::string solver = "xpbd", out;
   int threads = 1, substeps = -1;
@@ -36,14 +34,18 @@ int main(int argc, char** argv) {
   app.add_option("--solver", solver, "xpbd (default) | explicit (the seed's explicit springs)")
       ->check(CLI::IsMember({"xpbd", "explicit"}))
       ->capture_default_str();
-  app.add_option("--substeps", substeps, "solver substeps per 1/60 s frame (default: the solver's)")->check(CLI::Range(1, 64));
+  app.add_option("--substeps", substeps, "solver substeps per 1/60 s frame (default: the solver's)")
+      ->check(CLI::Range(1, 64));
   app.add_flag("--self-collision", selfCollision, "keep the cape from passing through itself");
-  app.add_option("--threads", threads, "worker threads stepping the capes")->check(CLI::Range(1, 256))->capture_default_str();
+  app.add_option("--threads", threads, "worker threads stepping the capes")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
   app.add_option("--out", out, "output folder (default: a fresh cape_run_<scene>_<time> folder)");
   app.add_flag("--no-frames", noFrames, "do not write frames/*.obj");
   std::string gltf, render, renderSize = "640x360";
   app.add_option("--gltf", gltf, "also write the run as an animated glTF 2.0 binary (.glb)");
-  app.add_option("--render", render, "also render PNG frames (and run.mp4, run.gif with ffmpeg) into this folder");
+  app.add_option("--render", render,
+                 "also render PNG frames (and run.mp4, run.gif with ffmpeg) into this folder");
   app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
@@ -55,7 +57,8 @@ int main(int argc, char** argv) {
   if (solver == "explicit") {
     o.settings = CapeSettings::unitySeed();
     o.settings.timeStep = 1.0f / 60.0f;
-    o.settings.substeps = 8;  // 1/480 s: within the explicit springs' stability bound (0.00875 s is the seed's)
+    o.settings.substeps =
+        8;  // 1/480 s: within the explicit springs' stability bound (0.00875 s is the seed's)
     // At 1/480 s the explicit springs stay stable up to ~57 N/m on the canonical cape's 1 g particles; the
     // seed's 3 N/m (stable at 0.00875 s) would let the cape stretch to several times its length.
     o.settings.structuralStiffness = 40.0f;
@@ -120,7 +123,8 @@ int main(int argc, char** argv) {
     std::vector<Collider> allColliders;
     for (int k = 0; k < run->characterCount(); ++k) {
       const std::vector<Collider> colliders = run->bodyColliders(k);
-      const FrameMetrics m = measureFrame(run->cape(k), colliders, run->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
+      const FrameMetrics m =
+          measureFrame(run->cape(k), colliders, run->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
       recorders[static_cast<std::size_t>(k)].add(m);
       row.metrics = k == 0 ? m : worstOf(row.metrics, m);  // a crowd's row holds the worst of its characters
       writer->capeMesh(f, k, run->cape(k));
@@ -148,8 +152,8 @@ int main(int argc, char** argv) {
   }
   if (gltfRecorder) std::printf("cape_walk: glTF animation -> %s\n", gltf.c_str());
   if (renderer) {
-    std::printf("cape_walk: %d frames rendered at %dx%d (%.1f ms each) -> %s\n", renderer->frames(), renderWidth,
-                renderHeight, renderer->meanRenderMs(), render.c_str());
+    std::printf("cape_walk: %d frames rendered at %dx%d (%.1f ms each) -> %s\n", renderer->frames(),
+                renderWidth, renderHeight, renderer->meanRenderMs(), render.c_str());
   }
 
   // Summary: per character and, for the table, the worst character.
@@ -162,7 +166,9 @@ int main(int argc, char** argv) {
   summary["attachment"] = attachment;
   summary["characters"] = run->characterCount();
   summary["threads"] = threads;
-  summary["grid"] = {{"columns", size}, {"rows", size}, {"particles", size * size},
+  summary["grid"] = {{"columns", size},
+                     {"rows", size},
+                     {"particles", size * size},
                      {"springs", run->cape(0).fabric().springCount()}};
   summary["cape"] = {{"width_m", 0.6}, {"height_m", 1.0}, {"mass_kg", run->cape(0).fabric().totalMass()}};
   summary["frame_time_s"] = 1.0 / 60.0;
@@ -178,26 +184,35 @@ int main(int argc, char** argv) {
   if (run->characterCount() > 1) {
     for (std::size_t k = 0; k < recorders.size(); ++k) {
       std::vector<FrameRow> own;
-      for (std::size_t f = 0; f < rows.size(); ++f) own.push_back({rows[f].frame, rows[f].time, rows[f].frameTimeUs, rows[f].capeTimeUs, recorders[k].frames()[f]});
+      for (std::size_t f = 0; f < rows.size(); ++f)
+        own.push_back(
+            {rows[f].frame, rows[f].time, rows[f].frameTimeUs, rows[f].capeTimeUs, recorders[k].frames()[f]});
       summary["per_character"].push_back(summaryFigures(own, recorders[k].summary()));
     }
   }
   writer->summary(summary);
 
   const nlohmann::json& s = summary["summary"];
-  std::printf("cape_walk: scene %s, %d x %d cape, %d character(s), %d frames -> %s\n", scene.c_str(), size, size,
-              run->characterCount(), static_cast<int>(rows.size()), dir.c_str());
-  std::printf("  %-34s %10.1f us (p95 %.1f)\n", "frame time, median", s["frame_time_us_median"].get<double>(), s["frame_time_us_p95"].get<double>());
-  std::printf("  %-34s %10.1f us (p95 %.1f)\n", "cape time, median", s["cape_time_us_median"].get<double>(), s["cape_time_us_p95"].get<double>());
-  std::printf("  %-34s %10.2f %%  (median frame %.2f %%, p95 frame %.2f %%)\n", "strain, max", 100.0 * q.maxStrain, 100.0 * q.medianFrameMaxStrain, 100.0 * q.p95FrameMaxStrain);
+  std::printf("cape_walk: scene %s, %d x %d cape, %d character(s), %d frames -> %s\n", scene.c_str(), size,
+              size, run->characterCount(), static_cast<int>(rows.size()), dir.c_str());
+  std::printf("  %-34s %10.1f us (p95 %.1f)\n", "frame time, median", s["frame_time_us_median"].get<double>(),
+              s["frame_time_us_p95"].get<double>());
+  std::printf("  %-34s %10.1f us (p95 %.1f)\n", "cape time, median", s["cape_time_us_median"].get<double>(),
+              s["cape_time_us_p95"].get<double>());
+  std::printf("  %-34s %10.2f %%  (median frame %.2f %%, p95 frame %.2f %%)\n", "strain, max",
+              100.0 * q.maxStrain, 100.0 * q.medianFrameMaxStrain, 100.0 * q.p95FrameMaxStrain);
   std::printf("  %-34s %10.3f %%\n", "strain, mean", 100.0 * q.meanStrain);
-  std::printf("  %-34s %10.4f m  (%d frames over 1 mm)\n", "penetration, max", q.maxPenetration, q.framesPenetrationOver1mm);
-  std::printf("  %-34s %10d    (%d frames with any)\n", "self-intersections, max", q.selfIntersectionsMax, q.framesWithSelfIntersections);
+  std::printf("  %-34s %10.4f m  (%d frames over 1 mm)\n", "penetration, max", q.maxPenetration,
+              q.framesPenetrationOver1mm);
+  std::printf("  %-34s %10d    (%d frames with any)\n", "self-intersections, max", q.selfIntersectionsMax,
+              q.framesWithSelfIntersections);
   std::printf("  %-34s %10.2g m\n", "pin error, max", q.pinErrorMax);
-  if (o.scene == SceneKind::Hang) std::printf("  %-34s %10.4f m/s\n", "rest jitter (last second)", q.restJitter);
+  if (o.scene == SceneKind::Hang)
+    std::printf("  %-34s %10.4f m/s\n", "rest jitter (last second)", q.restJitter);
   std::printf("  %-34s %10s\n", "blow-up", q.blowUp ? "YES" : "no");
   if (blowUp) {
-    std::fprintf(stderr, "cape_walk: the cape blew up at frame %d (NaN or a particle > 10 m from the torso)\n",
+    std::fprintf(stderr,
+                 "cape_walk: the cape blew up at frame %d (NaN or a particle > 10 m from the torso)\n",
                  static_cast<int>(rows.size()));
     return 2;
   }

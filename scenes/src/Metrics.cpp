@@ -26,7 +26,8 @@ float maxPenetration(const Points& x, ColliderSpan colliders) {
   float worst = 0.0f;
   for (const Collider& c : colliders) {
     if (!c.validate().ok()) continue;
-    for (Eigen::Index i = 0; i < x.rows(); ++i) worst = std::max(worst, -signedDistance(c, x.row(i).transpose()));
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      worst = std::max(worst, -signedDistance(c, x.row(i).transpose()));
   }
   return worst;
 }
@@ -37,7 +38,9 @@ float maxPinError(const Points& x, const std::vector<Pin>& pins) {
   return worst;
 }
 
-float maxPinError(const CapeState& state) { return maxPinError(state.positions, state.pins); }
+float maxPinError(const CapeState& state) {
+  return maxPinError(state.positions, state.pins);
+}
 
 bool isBlownUp(const Points& x, const Vec3& centre, float radius) {
   if (!x.allFinite()) return true;
@@ -81,7 +84,9 @@ bool interval(const double p[3], const double d[3], double& lo, double& hi) {
   return true;
 }
 
-double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 bool segmentsIntersect2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
                          const Eigen::Vector2d& d) {
@@ -89,15 +94,16 @@ bool segmentsIntersect2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, con
   const double d3 = cross2(d - c, a - c), d4 = cross2(d - c, b - c);
   if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
   auto onSegment = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
-    return std::min(p.x(), q.x()) <= r.x() && r.x() <= std::max(p.x(), q.x()) && std::min(p.y(), q.y()) <= r.y() &&
-           r.y() <= std::max(p.y(), q.y());
+    return std::min(p.x(), q.x()) <= r.x() && r.x() <= std::max(p.x(), q.x()) &&
+           std::min(p.y(), q.y()) <= r.y() && r.y() <= std::max(p.y(), q.y());
   };
-  return (d1 == 0 && onSegment(a, b, c)) || (d2 == 0 && onSegment(a, b, d)) || (d3 == 0 && onSegment(c, d, a)) ||
-         (d4 == 0 && onSegment(c, d, b));
+  return (d1 == 0 && onSegment(a, b, c)) || (d2 == 0 && onSegment(a, b, d)) ||
+         (d3 == 0 && onSegment(c, d, a)) || (d4 == 0 && onSegment(c, d, b));
 }
 
 bool pointInTriangle2d(const Eigen::Vector2d& p, const Eigen::Vector2d t[3]) {
-  const double a = cross2(t[1] - t[0], p - t[0]), b = cross2(t[2] - t[1], p - t[1]), c = cross2(t[0] - t[2], p - t[2]);
+  const double a = cross2(t[1] - t[0], p - t[0]), b = cross2(t[2] - t[1], p - t[1]),
+               c = cross2(t[0] - t[2], p - t[2]);
   return (a >= 0 && b >= 0 && c >= 0) || (a <= 0 && b <= 0 && c <= 0);
 }
 
@@ -162,21 +168,23 @@ int SelfIntersectionCounter::count(const Fabric& fabric, const Points& x) {
     const std::uint32_t* ti = &tri[3 * bi.triangle];
     for (std::size_t j = i + 1; j < nt && boxes_[j].lo.x() <= bi.hi.x(); ++j) {
       const Box& bj = boxes_[j];
-      if (bj.lo.y() > bi.hi.y() || bj.hi.y() < bi.lo.y() || bj.lo.z() > bi.hi.z() || bj.hi.z() < bi.lo.z()) continue;
+      if (bj.lo.y() > bi.hi.y() || bj.hi.y() < bi.lo.y() || bj.lo.z() > bi.hi.z() || bj.hi.z() < bi.lo.z())
+        continue;
       const std::uint32_t* tj = &tri[3 * bj.triangle];
       bool shares = false;
       for (int a = 0; a < 3 && !shares; ++a)
         for (int b = 0; b < 3; ++b) shares = shares || ti[a] == tj[b];
       if (shares) continue;
-      if (trianglesIntersect(x.row(ti[0]), x.row(ti[1]), x.row(ti[2]), x.row(tj[0]), x.row(tj[1]), x.row(tj[2])))
+      if (trianglesIntersect(x.row(ti[0]), x.row(ti[1]), x.row(ti[2]), x.row(tj[0]), x.row(tj[1]),
+                             x.row(tj[2])))
         ++found;
     }
   }
   return found;
 }
 
-FrameMetrics measureFrame(const Fabric& fabric, const Points& x, const Points& v, const std::vector<Pin>& pins,
-                          ColliderSpan bodyColliders, const Vec3& torsoCentre,
+FrameMetrics measureFrame(const Fabric& fabric, const Points& x, const Points& v,
+                          const std::vector<Pin>& pins, ColliderSpan bodyColliders, const Vec3& torsoCentre,
                           SelfIntersectionCounter* selfIntersections) {
   FrameMetrics m;
   m.blowUp = isBlownUp(x, torsoCentre);
@@ -194,8 +202,8 @@ FrameMetrics measureFrame(const Fabric& fabric, const Points& x, const Points& v
 FrameMetrics measureFrame(const Cape& cape, ColliderSpan bodyColliders, const Vec3& torsoCentre,
                           SelfIntersectionCounter* selfIntersections) {
   const CapeState& state = cape.state();
-  return measureFrame(cape.fabric(), state.positions, state.velocities, state.pins, bodyColliders, torsoCentre,
-                      selfIntersections);
+  return measureFrame(cape.fabric(), state.positions, state.velocities, state.pins, bodyColliders,
+                      torsoCentre, selfIntersections);
 }
 
 FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b) {
@@ -218,7 +226,9 @@ double percentile(std::vector<double> v, double p) {
   return v[k];
 }
 
-void MetricsRecorder::add(const FrameMetrics& m) { frames_.push_back(m); }
+void MetricsRecorder::add(const FrameMetrics& m) {
+  frames_.push_back(m);
+}
 
 RunSummary MetricsRecorder::summary() const {
   RunSummary r;
@@ -246,7 +256,8 @@ RunSummary MetricsRecorder::summary() const {
   const std::size_t from = frames_.size() > last ? frames_.size() - last : 0;
   double speed = 0.0;
   for (std::size_t i = from; i < frames_.size(); ++i) speed += frames_[i].meanSpeed;
-  if (frames_.size() > from) r.restJitter = static_cast<float>(speed / static_cast<double>(frames_.size() - from));
+  if (frames_.size() > from)
+    r.restJitter = static_cast<float>(speed / static_cast<double>(frames_.size() - from));
   return r;
 }
 

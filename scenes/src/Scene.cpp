@@ -7,7 +7,9 @@ namespace cape {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
-Quat yawRotation(float yaw) { return Quat(Eigen::AngleAxisf(yaw, Vec3::UnitY())); }
+Quat yawRotation(float yaw) {
+  return Quat(Eigen::AngleAxisf(yaw, Vec3::UnitY()));
+}
 
 // Torso, shoulders, legs of docs/SCENES.md, in the character frame.
 const Vec3 kTorsoCentre(0.0f, 1.25f, 0.0f);
@@ -40,17 +42,23 @@ CapeSettings settingsForScene(SceneKind kind, CapeSettings settings) {
 
 const char* toString(SceneKind kind) {
   switch (kind) {
-    case SceneKind::Hang: return "hang";
-    case SceneKind::Walk: return "walk";
-    case SceneKind::SprintTurn: return "sprint-turn";
-    case SceneKind::Wind: return "wind";
-    case SceneKind::Crowd: return "crowd";
+    case SceneKind::Hang:
+      return "hang";
+    case SceneKind::Walk:
+      return "walk";
+    case SceneKind::SprintTurn:
+      return "sprint-turn";
+    case SceneKind::Wind:
+      return "wind";
+    case SceneKind::Crowd:
+      return "crowd";
   }
   return "?";
 }
 
 bool parseSceneKind(const std::string& name, SceneKind& kind) {
-  for (SceneKind k : {SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind, SceneKind::Crowd}) {
+  for (SceneKind k :
+       {SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind, SceneKind::Crowd}) {
     if (name == toString(k)) {
       kind = k;
       return true;
@@ -59,12 +67,17 @@ bool parseSceneKind(const std::string& name, SceneKind& kind) {
   return false;
 }
 
-const char* toString(PinLayout layout) { return layout == PinLayout::Corners ? "corners" : "collar"; }
+const char* toString(PinLayout layout) {
+  return layout == PinLayout::Corners ? "corners" : "collar";
+}
 
 bool parsePinLayout(const std::string& name, PinLayout& layout) {
-  if (name == "corners") layout = PinLayout::Corners;
-  else if (name == "collar") layout = PinLayout::Collar;
-  else return false;
+  if (name == "corners")
+    layout = PinLayout::Corners;
+  else if (name == "collar")
+    layout = PinLayout::Collar;
+  else
+    return false;
   return true;
 }
 
@@ -168,7 +181,8 @@ void SimpleBody::moveTo(const BodyPose& pose, bool teleport) {
       colliders_[static_cast<std::size_t>(k)].moveTo(world);
   };
   place(kTorso, Pose{kTorsoCentre, Quat::Identity()});
-  place(kLeftShoulder, Pose{Vec3(-kShoulderCentre.x(), kShoulderCentre.y(), kShoulderCentre.z()), Quat::Identity()});
+  place(kLeftShoulder,
+        Pose{Vec3(-kShoulderCentre.x(), kShoulderCentre.y(), kShoulderCentre.z()), Quat::Identity()});
   place(kRightShoulder, Pose{kShoulderCentre, Quat::Identity()});
   for (int side = 0; side < 2; ++side) {
     const float sign = side == 0 ? -1.0f : 1.0f;  // left (-X) swings +angle, right -angle
@@ -229,7 +243,8 @@ SimpleScene::SimpleScene(SceneKind kind, int n, PinLayout layout, const CapeSett
     b.position += offset_;
     return b.frame();
   }();
-  for (std::size_t k = 0; k < rig_.pinnedParticles.size(); ++k) cape_.pin(rig_.pinnedParticles[k], frame.apply(rig_.pinLocalPoints[k]));
+  for (std::size_t k = 0; k < rig_.pinnedParticles.size(); ++k)
+    cape_.pin(rig_.pinnedParticles[k], frame.apply(rig_.pinLocalPoints[k]));
 }
 
 void SimpleScene::advanceFrame(float dt) {
@@ -238,7 +253,8 @@ void SimpleScene::advanceFrame(float dt) {
   body_.moveTo(pose);
   pose.position += offset_;
   const Pose frame = pose.frame();
-  for (std::size_t k = 0; k < rig_.pinnedParticles.size(); ++k) cape_.movePin(k, frame.apply(rig_.pinLocalPoints[k]));
+  for (std::size_t k = 0; k < rig_.pinnedParticles.size(); ++k)
+    cape_.movePin(k, frame.apply(rig_.pinLocalPoints[k]));
   cape_.step(dt, body_.colliders());
 }
 

@@ -39,8 +39,8 @@ void runFrames(benchmark::State& state, SceneKind kind, const CapeSettings& sett
     searches += scene.cape().selfContactSearches();
     state.counters["searches_per_frame"] = static_cast<double>(searches - searchesBefore) / frames;
   }
-  state.counters["particles_per_s"] =
-      benchmark::Counter(static_cast<double>(n) * n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["particles_per_s"] = benchmark::Counter(
+      static_cast<double>(n) * n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 CapeSettings fixedSubsteps() {
@@ -49,8 +49,12 @@ CapeSettings fixedSubsteps() {
   return s;
 }
 
-void BM_WalkFrame(benchmark::State& state) { runFrames(state, SceneKind::Walk, fixedSubsteps()); }
-void BM_WalkFrameAdaptive(benchmark::State& state) { runFrames(state, SceneKind::Walk, CapeSettings()); }
+void BM_WalkFrame(benchmark::State& state) {
+  runFrames(state, SceneKind::Walk, fixedSubsteps());
+}
+void BM_WalkFrameAdaptive(benchmark::State& state) {
+  runFrames(state, SceneKind::Walk, CapeSettings());
+}
 void BM_WalkFrame4Substeps(benchmark::State& state) {
   CapeSettings s = fixedSubsteps();
   s.substeps = 4;
@@ -67,12 +71,17 @@ void BM_SprintTurnFrameSelfCollision(benchmark::State& state) {
   s.selfCollision = true;
   runFrames(state, SceneKind::SprintTurn, s);
 }
-void BM_SprintTurnFrame(benchmark::State& state) { runFrames(state, SceneKind::SprintTurn, CapeSettings()); }
-void BM_SprintTurnFrameFixed(benchmark::State& state) { runFrames(state, SceneKind::SprintTurn, fixedSubsteps()); }
+void BM_SprintTurnFrame(benchmark::State& state) {
+  runFrames(state, SceneKind::SprintTurn, CapeSettings());
+}
+void BM_SprintTurnFrameFixed(benchmark::State& state) {
+  runFrames(state, SceneKind::SprintTurn, fixedSubsteps());
+}
 void BM_WalkFrameSeedExplicit(benchmark::State& state) {
   CapeSettings s = CapeSettings::unitySeed();
   s.timeStep = 1.0f / 60.0f;
-  s.substeps = 8;  // the seed's 0.00875 s step would need ~2 steps per 1/60 s frame; 8 keeps it stable at N = 64
+  s.substeps =
+      8;  // the seed's 0.00875 s step would need ~2 steps per 1/60 s frame; 8 keeps it stable at N = 64
   runFrames(state, SceneKind::Walk, s);
 }
 

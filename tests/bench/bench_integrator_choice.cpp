@@ -10,8 +10,8 @@
 #include "cape/scenes/Metrics.h"
 #include "cape/scenes/Scene.h"
 
-#include <Eigen/SparseCholesky>
 #include <benchmark/benchmark.h>
+#include <Eigen/SparseCholesky>
 
 #include <vector>
 
@@ -34,7 +34,8 @@ std::vector<Vec3> pinTargets(const CapeRig& rig, const MotionDesc& motion, doubl
 /// with the pinned particles eliminated (known values moved to the right-hand side).
 class LiuMassSpring {
  public:
-  LiuMassSpring(const Fabric& fabric, const CapeSettings& s, const Points& start, const std::vector<std::uint32_t>& pinned)
+  LiuMassSpring(const Fabric& fabric, const CapeSettings& s, const Points& start,
+                const std::vector<std::uint32_t>& pinned)
       : fabric_(fabric), settings_(s), x_(start.cast<double>()), v_(Eigen::MatrixX3d::Zero(start.rows(), 3)) {
     const Eigen::Index n = start.rows();
     isPinned_.assign(static_cast<std::size_t>(n), false);
@@ -46,12 +47,15 @@ class LiuMassSpring {
       const double k = f == 0 ? s.structuralStiffness : f == 1 ? s.shearStiffness : s.bendStiffness;
       if (k <= 0.0) continue;
       const SpringSet& set = fabric.springs(static_cast<SpringFamily>(f));
-      for (std::size_t q = 0; q < set.size(); ++q) springs_.push_back({set.first[q], set.second[q], set.restLength[q], k});
+      for (std::size_t q = 0; q < set.size(); ++q)
+        springs_.push_back({set.first[q], set.second[q], set.restLength[q], k});
     }
     const double h = kFrame;
     std::vector<Eigen::Triplet<double>> t;
     for (Eigen::Index i = 0; i < n; ++i)
-      if (freeIndex_[static_cast<std::size_t>(i)] >= 0) t.emplace_back(freeIndex_[static_cast<std::size_t>(i)], freeIndex_[static_cast<std::size_t>(i)], fabric.masses()[i]);
+      if (freeIndex_[static_cast<std::size_t>(i)] >= 0)
+        t.emplace_back(freeIndex_[static_cast<std::size_t>(i)], freeIndex_[static_cast<std::size_t>(i)],
+                       fabric.masses()[i]);
     for (const Spring& sp : springs_) {
       const int a = freeIndex_[sp.i], b = freeIndex_[sp.j];
       const double w = h * h * sp.k;
@@ -70,7 +74,9 @@ class LiuMassSpring {
     d_.resize(static_cast<Eigen::Index>(springs_.size()), 3);
   }
 
-  void setPin(std::uint32_t particle, const Vec3& target) { x_.row(particle) = target.cast<double>().transpose(); }
+  void setPin(std::uint32_t particle, const Vec3& target) {
+    x_.row(particle) = target.cast<double>().transpose();
+  }
 
   void step(int iterations) {
     const double h = kFrame;
@@ -162,8 +168,9 @@ void BM_WalkPinsXpbd(benchmark::State& state) {
     reportStrain(state, rec);
     state.ResumeTiming();
   }
-  state.counters["us_per_frame"] = benchmark::Counter(static_cast<double>(state.iterations()) * kFrames,
-                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["us_per_frame"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * kFrames,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 // Liu et al.: range(0) = local/global iterations per 1/60 s frame.
@@ -189,12 +196,18 @@ void BM_WalkPinsLiu(benchmark::State& state) {
     reportStrain(state, rec);
     state.ResumeTiming();
   }
-  state.counters["us_per_frame"] = benchmark::Counter(static_cast<double>(state.iterations()) * kFrames,
-                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["us_per_frame"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * kFrames,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 }  // namespace
 
-BENCHMARK(BM_WalkPinsXpbd)->Args({3, 1})->Args({3, 0})->Args({8, 0})->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_WalkPinsXpbd)
+    ->Args({3, 1})
+    ->Args({3, 0})
+    ->Args({8, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
 BENCHMARK(BM_WalkPinsLiu)->Arg(5)->Arg(10)->Arg(20)->Arg(40)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_MAIN();

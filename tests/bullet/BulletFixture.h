@@ -16,12 +16,6 @@
 #include <memory>
 #include <vector>
 
-namespace cape {
-// The pin layout's old name (it clashed with cape::bullet::Attachment, a pinned particle of the adapter), kept
-// only for the files that still say cape::Attachment (test_cape_action.cpp); remove once they say PinLayout.
-using Attachment = PinLayout;
-}  // namespace cape
-
 namespace capetest {
 
 constexpr btScalar kFrame = btScalar(1.0 / 60.0);
@@ -92,7 +86,9 @@ struct World {
     }
   }
   btSoftRigidDynamicsWorld* soft() { return static_cast<btSoftRigidDynamicsWorld*>(world.get()); }
-  btDeformableMultiBodyDynamicsWorld* deformable() { return static_cast<btDeformableMultiBodyDynamicsWorld*>(world.get()); }
+  btDeformableMultiBodyDynamicsWorld* deformable() {
+    return static_cast<btDeformableMultiBodyDynamicsWorld*>(world.get());
+  }
 
   /// A static body (mass 0) with the shape at the transform; group/mask < 0: Bullet's defaults.
   btRigidBody* addStatic(btCollisionShape* shape, const btTransform& t, int group = -1, int mask = -1) {

@@ -507,7 +507,7 @@ TEST(CapeAction, DebugDrawDrawsEveryTriangleEdge) {
 }
 
 TEST(CapeAction, WalkOnTheSimpleBodyPinnedToTheShoulders) {
-  // SCENARIOS.md's walk on kinematic Bullet bodies (torso, shoulders, legs as rigid parts of the moving
+  // docs/SCENES.md's walk on kinematic Bullet bodies (torso, shoulders, legs as rigid parts of the moving
   // character frame; the legs do not swing here), the cape pinned by its corners to the shoulder spheres,
   // stepped by stepSimulation(1/60, 8, 1/240) for 2 s.
   World w;
@@ -524,7 +524,7 @@ TEST(CapeAction, WalkOnTheSimpleBodyPinnedToTheShoulders) {
   part(new btCapsuleShape(0.07f, 0.66f), btVector3(0.1f, 0.55f, 0));
   w.addStatic(new btStaticPlaneShape(btVector3(0, 1, 0), 0), btTransform::getIdentity());
 
-  const cape::CapeRig rig = cape::makeCapeRig(20, cape::Attachment::Corners);
+  const cape::CapeRig rig = cape::makeCapeRig(20, cape::PinLayout::Corners);
   CapeAction action(rig.fabric, cape::CapeSettings(),
                     cape::bullet::toBt(cape::capeStartPlacement(cape::SceneKind::Walk)));
   const btRigidBody* shoulders[2] = {left, right};

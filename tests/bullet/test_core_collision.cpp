@@ -50,8 +50,9 @@ TEST_P(FastConvexHull, At20MetresPerSecondThroughAHangingCapeLeavesNoParticleIns
   World w;
   btRigidBody* bar = w.addKinematic(new btBoxShape(btVector3(0.4f, 0.02f, 0.02f)),
                                     btTransform(btQuaternion::getIdentity(), btVector3(0, 1.6f, 0.15f)));
-  btCollisionShape* shape = GetParam() == 0 ? static_cast<btCollisionShape*>(boxAsHull(btVector3(0.25f, 0.25f, 0.02f)))
-                                            : static_cast<btCollisionShape*>(wedgeHull());
+  btCollisionShape* shape = GetParam() == 0
+                                ? static_cast<btCollisionShape*>(boxAsHull(btVector3(0.25f, 0.25f, 0.02f)))
+                                : static_cast<btCollisionShape*>(wedgeHull());
   btTransform pose(btQuaternion::getIdentity(), btVector3(0, 1.15f, 1.0f));
   btRigidBody* hull = w.addKinematic(shape, pose);
   CapeAction action(cornerFabric(), cape::CapeSettings(),

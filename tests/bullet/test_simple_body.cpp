@@ -1,5 +1,6 @@
-// The simple body as kinematic Bullet bodies (cape::BulletSimpleBody, library cape::scenes_bullet): the bodies
-// the demos' Bullet scene and the adapter's tests put in a world for the simple body of docs/SCENES.md.
+// The simple body as kinematic Bullet bodies (cape::BulletSimpleBody, library cape::scenes_bullet): the
+// bodies the demos' Bullet scene and the adapter's tests put in a world for the simple body of
+// docs/SCENES.md.
 #include "BulletFixture.h"
 
 #include "cape/bullet/Convert.h"
@@ -34,8 +35,9 @@ TEST(BulletSimpleBody, OneKinematicBodyPerColliderOnItsTrueSurfaceFollowingThePo
       for (const cape::Vec3& d : {cape::Vec3(0.3f, 0.0f, 0.0f), cape::Vec3(0.0f, 0.5f, 0.0f),
                                   cape::Vec3(0.0f, -0.2f, 0.15f), cape::Vec3(0.01f, 0.02f, -0.03f)}) {
         const cape::Vec3 p = c.current.position + d;
-        EXPECT_NEAR(cape::bullet::shapeSignedDistance(b->getCollisionShape(), b->getWorldTransform(), toBt(p)),
-                    cape::signedDistance(c, p), 1e-4f)
+        EXPECT_NEAR(
+            cape::bullet::shapeSignedDistance(b->getCollisionShape(), b->getWorldTransform(), toBt(p)),
+            cape::signedDistance(c, p), 1e-4f)
             << c.name;
       }
     }

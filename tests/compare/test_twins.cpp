@@ -1,6 +1,6 @@
-// The comparison's twins in real Bullet worlds: the btSoftBody twin has the cape's nodes, masses, links, faces
-// and anchors and collides with the same rigid bodies; the deformable-world twin hangs from and follows the
-// body it is anchored to.
+// The comparison's twins in real Bullet worlds: the btSoftBody twin has the cape's nodes, masses, links,
+// faces and anchors and collides with the same rigid bodies; the deformable-world twin hangs from and follows
+// the body it is anchored to.
 #include "BulletFixture.h"
 
 #include "cape/compare/SoftBodyTwin.h"
@@ -86,7 +86,8 @@ TEST(DeformableTwin, HangsFromTheBodyItIsAnchoredToAndFollowsIt) {
   action.attach(0, body, btVector3(-0.3f, 0.06f, 0.15f));
   action.attach(19, body, btVector3(0.3f, 0.06f, 0.15f));
   const cape::Fabric& fabric = action.cape().fabric();
-  std::unique_ptr<cape::compare::DeformableTwin> twin = cape::compare::makeDeformableTwin(*w.deformable(), action);
+  std::unique_ptr<cape::compare::DeformableTwin> twin =
+      cape::compare::makeDeformableTwin(*w.deformable(), action);
   ASSERT_NE(twin, nullptr);
   const btSoftBody& b = twin->body();
   EXPECT_EQ(b.m_nodes.size(), int(fabric.particleCount()));

@@ -51,8 +51,8 @@ int main() {
   const float lowest = x.col(1).minCoeff();
   const float front = x.col(2).minCoeff();  // no particle in front of the torso's back (z = -0.12 .. 0.12)
   const bool ok = x.allFinite() && lowest < 0.65f && front > 0.12f && cape.attachments().size() == 2;
-  std::printf("bullet consumer: lowest particle at y = %.3f m, nearest the body at z = %.3f m: %s\n", lowest, front,
-              ok ? "ok" : "FAILED");
+  std::printf("bullet consumer: lowest particle at y = %.3f m, nearest the body at z = %.3f m: %s\n", lowest,
+              front, ok ? "ok" : "FAILED");
   world.removeAction(&cape);
   world.removeRigidBody(torso.get());
   world.removeRigidBody(rightShoulder);

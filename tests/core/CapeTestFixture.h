@@ -31,8 +31,8 @@ inline CapeSettings quietSettings() {
 }
 
 /// A grid fabric; fails the calling test if it cannot be built.
-inline FabricPtr makeGrid(int columns, int rows, float width = 0.6f, float height = 1.0f, float totalMass = 0.4f,
-                          bool bend = true, std::vector<std::uint32_t> anchors = {}) {
+inline FabricPtr makeGrid(int columns, int rows, float width = 0.6f, float height = 1.0f,
+                          float totalMass = 0.4f, bool bend = true, std::vector<std::uint32_t> anchors = {}) {
   GridDesc g;
   g.columns = columns;
   g.rows = rows;
@@ -95,6 +95,8 @@ inline std::uint64_t hashPoints(const Points& p) {
   return h;
 }
 
-inline Vec3 row(const Points& p, Eigen::Index i) { return p.row(i).transpose(); }
+inline Vec3 row(const Points& p, Eigen::Index i) {
+  return p.row(i).transpose();
+}
 
 }  // namespace cape::test

@@ -29,7 +29,8 @@ struct LoneParticle {
   /// Puts particle 0 at `p` (at rest) and the others 100 m away, then steps one frame.
   Vec3 pushOut(const Vec3& p, const Collider& c) {
     Points& x = cape.mutableState().positions;
-    for (Eigen::Index i = 1; i < x.rows(); ++i) x.row(i) = (p + Vec3(100.0f + static_cast<float>(i), 100.0f, 0.0f)).transpose();
+    for (Eigen::Index i = 1; i < x.rows(); ++i)
+      x.row(i) = (p + Vec3(100.0f + static_cast<float>(i), 100.0f, 0.0f)).transpose();
     x.row(0) = p.transpose();
     cape.mutableState().velocities.setZero();
     std::vector<Collider> colliders{c};
@@ -46,7 +47,9 @@ struct PushOutCase {
   Vec3 expected;  ///< its nearest surface point, worked out by hand
 };
 // GoogleTest prints parameters on failure; the name is enough.
-void PrintTo(const PushOutCase& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const PushOutCase& c, std::ostream* os) {
+  *os << c.name;
+}
 
 std::vector<PushOutCase> pushOutCases() {
   const Vec3 c(1.0f, 2.0f, 3.0f);
@@ -68,14 +71,15 @@ std::vector<PushOutCase> pushOutCases() {
   // An oriented box: 30 degrees about Y. Local (0.1, 0.15, 0) is nearest the +Y face.
   Pose boxPose = at;
   boxPose.rotation = Quat(Eigen::AngleAxisf(kPi / 6.0f, Vec3::UnitY()));
-  cases.push_back({"box_oriented", Collider::box(Vec3(0.5f, 0.2f, 0.3f), boxPose), boxPose.apply(Vec3(0.1f, 0.15f, 0.0f)),
-                   boxPose.apply(Vec3(0.1f, 0.2f, 0.0f))});
+  cases.push_back({"box_oriented", Collider::box(Vec3(0.5f, 0.2f, 0.3f), boxPose),
+                   boxPose.apply(Vec3(0.1f, 0.15f, 0.0f)), boxPose.apply(Vec3(0.1f, 0.2f, 0.0f))});
   // Nearest the local +X face after a rotation about Z by 45 degrees.
   Pose boxPose2 = at;
   boxPose2.rotation = Quat(Eigen::AngleAxisf(kPi / 4.0f, Vec3::UnitZ()));
-  cases.push_back({"box_x_face", Collider::box(Vec3(0.5f, 0.4f, 0.3f), boxPose2), boxPose2.apply(Vec3(0.45f, 0.0f, 0.1f)),
-                   boxPose2.apply(Vec3(0.5f, 0.0f, 0.1f))});
-  cases.push_back({"plane", Collider::plane(Vec3(0.0f, 1.0f, 0.0f), 0.0f), Vec3(0.3f, -0.05f, 0.2f), Vec3(0.3f, 0.0f, 0.2f)});
+  cases.push_back({"box_x_face", Collider::box(Vec3(0.5f, 0.4f, 0.3f), boxPose2),
+                   boxPose2.apply(Vec3(0.45f, 0.0f, 0.1f)), boxPose2.apply(Vec3(0.5f, 0.0f, 0.1f))});
+  cases.push_back({"plane", Collider::plane(Vec3(0.0f, 1.0f, 0.0f), 0.0f), Vec3(0.3f, -0.05f, 0.2f),
+                   Vec3(0.3f, 0.0f, 0.2f)});
   cases.push_back({"plane_tilted", Collider::plane(Vec3(1.0f, 1.0f, 0.0f), 0.0f), Vec3(0.0f, -0.2f, 0.5f),
                    Vec3(0.1f, -0.1f, 0.5f)});
   return cases;
@@ -94,7 +98,8 @@ TEST_P(PushOut, LandsOnTheNearestSurfacePoint) {
   LoneParticle lone;
   ASSERT_TRUE(lone.cape.ok());
   const Vec3 out = lone.pushOut(k.inside, k.collider);
-  EXPECT_LT((out - k.expected).norm(), 2e-5f) << "got " << out.transpose() << ", expected " << k.expected.transpose();
+  EXPECT_LT((out - k.expected).norm(), 2e-5f)
+      << "got " << out.transpose() << ", expected " << k.expected.transpose();
 }
 
 TEST_P(PushOut, ThicknessKeepsTheParticleThatFarOut) {
@@ -118,11 +123,14 @@ TEST(Colliders, SignedDistanceOutside) {
   Pose at;
   at.position = Vec3(0.0f, 1.0f, 0.0f);
   EXPECT_NEAR(signedDistance(Collider::sphere(0.5f, at), Vec3(0.0f, 2.0f, 0.0f)), 0.5f, 1e-6f);
-  EXPECT_NEAR(signedDistance(Collider::box(Vec3(0.5f, 0.5f, 0.5f), at), Vec3(1.5f, 2.5f, 0.0f)), std::sqrt(2.0f), 1e-6f);
+  EXPECT_NEAR(signedDistance(Collider::box(Vec3(0.5f, 0.5f, 0.5f), at), Vec3(1.5f, 2.5f, 0.0f)),
+              std::sqrt(2.0f), 1e-6f);
   EXPECT_NEAR(signedDistance(Collider::capsule(0.1f, 0.5f, 1, at), Vec3(0.0f, 2.0f, 0.0f)), 0.4f, 1e-6f);
-  EXPECT_NEAR(signedDistance(Collider::cylinder(0.1f, 0.5f, 1, at), Vec3(0.4f, 2.0f, 0.0f)), std::sqrt(0.34f), 1e-6f);  // rim
+  EXPECT_NEAR(signedDistance(Collider::cylinder(0.1f, 0.5f, 1, at), Vec3(0.4f, 2.0f, 0.0f)), std::sqrt(0.34f),
+              1e-6f);  // rim
   // 2y = 1 is the plane y = 0.5: the normal and the constant scale together.
-  EXPECT_NEAR(signedDistance(Collider::plane(Vec3(0.0f, 2.0f, 0.0f), 1.0f), Vec3(3.0f, 4.0f, 0.0f)), 3.5f, 1e-6f);
+  EXPECT_NEAR(signedDistance(Collider::plane(Vec3(0.0f, 2.0f, 0.0f), 1.0f), Vec3(3.0f, 4.0f, 0.0f)), 3.5f,
+              1e-6f);
 }
 
 TEST(Colliders, ValidateRejectsBadSizesAndPoses) {

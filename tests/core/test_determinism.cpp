@@ -10,7 +10,8 @@ std::uint64_t runScene(SceneKind kind, const CapeSettings& s, int frames) {
   SimpleScene scene(kind, 16, PinLayout::Corners, s);
   EXPECT_TRUE(scene.status().ok());
   for (int i = 0; i < frames; ++i) scene.advanceFrame();
-  return test::hashPoints(scene.cape().state().positions) ^ (test::hashPoints(scene.cape().state().velocities) << 1);
+  return test::hashPoints(scene.cape().state().positions) ^
+         (test::hashPoints(scene.cape().state().velocities) << 1);
 }
 
 TEST(Determinism, TwoRunsGiveIdenticalBits) {
@@ -32,7 +33,9 @@ TEST(Determinism, InterleavedCapesDoNotInfluenceEachOther) {
     b.advanceFrame();
     a.advanceFrame();
   }
-  EXPECT_EQ(test::hashPoints(a.cape().state().positions) ^ (test::hashPoints(a.cape().state().velocities) << 1), alone);
+  EXPECT_EQ(
+      test::hashPoints(a.cape().state().positions) ^ (test::hashPoints(a.cape().state().velocities) << 1),
+      alone);
 }
 
 TEST(Determinism, DifferentInputsGiveDifferentBits) {

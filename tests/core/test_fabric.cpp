@@ -25,8 +25,10 @@ void expectColoursShareNoParticle(const Fabric& f) {
       std::set<std::uint32_t> seen;
       EXPECT_LE(set.colourStart[c], set.colourStart[c + 1]);
       for (std::size_t s = set.colourStart[c]; s < set.colourStart[c + 1]; ++s) {
-        EXPECT_TRUE(seen.insert(set.first[s]).second) << toString(fam) << " colour " << c << " particle " << set.first[s];
-        EXPECT_TRUE(seen.insert(set.second[s]).second) << toString(fam) << " colour " << c << " particle " << set.second[s];
+        EXPECT_TRUE(seen.insert(set.first[s]).second)
+            << toString(fam) << " colour " << c << " particle " << set.first[s];
+        EXPECT_TRUE(seen.insert(set.second[s]).second)
+            << toString(fam) << " colour " << c << " particle " << set.second[s];
       }
     }
   }
@@ -129,7 +131,8 @@ TEST(Fabric, TethersOnlyWithAnchors) {
   for (std::size_t k = 0; k < t.size(); ++k) {
     EXPECT_TRUE(t.anchor[k] == 0u || t.anchor[k] == static_cast<std::uint32_t>(n - 1));
     EXPECT_NE(t.particle[k], t.anchor[k]);
-    const float d = (row(r.fabric->restPositions(), t.particle[k]) - row(r.fabric->restPositions(), t.anchor[k])).norm();
+    const float d =
+        (row(r.fabric->restPositions(), t.particle[k]) - row(r.fabric->restPositions(), t.anchor[k])).norm();
     EXPECT_NEAR(t.maxLength[k], 1.1f * d, 1e-5f);
   }
 
@@ -209,7 +212,8 @@ TEST(Fabric, FromMeshOfAGridsTriangles) {
   FabricPtr g = makeGrid(3, 3, 1.0f, 1.0f);
   ASSERT_TRUE(g);
   MeshDesc d;
-  for (Eigen::Index i = 0; i < g->restPositions().rows(); ++i) d.positions.push_back(row(g->restPositions(), i));
+  for (Eigen::Index i = 0; i < g->restPositions().rows(); ++i)
+    d.positions.push_back(row(g->restPositions(), i));
   d.triangles = g->triangles();
   d.tetherAnchors = {0, 2};
   expectMeshFabricMatchesEdges([&] {

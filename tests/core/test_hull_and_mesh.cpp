@@ -13,7 +13,8 @@ constexpr float kPi = 3.14159265f;
 /// A box as a convex hull: its 8 corners and 6 face planes.
 std::shared_ptr<const ConvexHull> boxHull(const Vec3& h) {
   std::vector<Vec3> v;
-  for (int i = 0; i < 8; ++i) v.emplace_back(i & 1 ? h.x() : -h.x(), i & 2 ? h.y() : -h.y(), i & 4 ? h.z() : -h.z());
+  for (int i = 0; i < 8; ++i)
+    v.emplace_back(i & 1 ? h.x() : -h.x(), i & 2 ? h.y() : -h.y(), i & 4 ? h.z() : -h.z());
   std::vector<Eigen::Vector4f> planes;
   for (int k = 0; k < 3; ++k)
     for (float s : {1.0f, -1.0f}) {
@@ -27,7 +28,8 @@ std::shared_ptr<const ConvexHull> boxHull(const Vec3& h) {
 
 /// A regular octahedron of "radius" r (vertices on the axes): faces not aligned with any axis.
 std::shared_ptr<const ConvexHull> octahedron(float r) {
-  std::vector<Vec3> v{r * Vec3::UnitX(), -r * Vec3::UnitX(), r * Vec3::UnitY(), -r * Vec3::UnitY(), r * Vec3::UnitZ(), -r * Vec3::UnitZ()};
+  std::vector<Vec3> v{r * Vec3::UnitX(),  -r * Vec3::UnitX(), r * Vec3::UnitY(),
+                      -r * Vec3::UnitY(), r * Vec3::UnitZ(),  -r * Vec3::UnitZ()};
   std::vector<Eigen::Vector4f> planes;
   for (int i = 0; i < 8; ++i) {
     const Vec3 n = Vec3(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f).normalized();
@@ -39,7 +41,8 @@ std::shared_ptr<const ConvexHull> octahedron(float r) {
 float worstDepth(const Points& x, const std::vector<Collider>& colliders) {
   float worst = 0.0f;
   for (const Collider& c : colliders)
-    for (Eigen::Index i = 0; i < x.rows(); ++i) worst = std::max(worst, -signedDistance(c, x.row(i).transpose()));
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      worst = std::max(worst, -signedDistance(c, x.row(i).transpose()));
   return worst;
 }
 
@@ -49,7 +52,8 @@ TEST(ConvexHullCollider, SignedDistanceIsTheBoxsInsideAndOverItsFaces) {
   const Collider box = Collider::box(h);
   ASSERT_TRUE(hull.validate().ok());
   ASSERT_TRUE(hull.hull->validate().ok());
-  for (const Vec3& p : {Vec3(0.0f, 0.0f, 0.0f), Vec3(0.1f, 0.05f, 0.01f), Vec3(0.0f, 0.3f, 0.0f), Vec3(0.1f, 0.0f, -0.2f)})
+  for (const Vec3& p :
+       {Vec3(0.0f, 0.0f, 0.0f), Vec3(0.1f, 0.05f, 0.01f), Vec3(0.0f, 0.3f, 0.0f), Vec3(0.1f, 0.0f, -0.2f)})
     EXPECT_FLOAT_EQ(signedDistance(hull, p), signedDistance(box, p)) << p.transpose();
   // Beside an edge outside: a lower bound of the true distance, never more.
   const Vec3 corner(0.3f, 0.2f, 0.0f);
@@ -85,7 +89,8 @@ TEST_P(FastHull, At20MetresPerSecondLeavesNoParticleInside) {
   pose.position = Vec3(0.0f, 0.0f, -0.3f);
   // A slab 2 cm thick, or an octahedron turned 30 degrees about Y so that its faces meet the cloth at angles.
   pose.rotation = slab ? Quat::Identity() : Quat(Eigen::AngleAxisf(0.5236f, Vec3::UnitY()));
-  std::vector<Collider> colliders{Collider::convexHull(slab ? boxHull(Vec3(1.0f, 1.0f, 0.01f)) : octahedron(0.12f), pose)};
+  std::vector<Collider> colliders{
+      Collider::convexHull(slab ? boxHull(Vec3(1.0f, 1.0f, 0.01f)) : octahedron(0.12f), pose)};
   const float dt = 1.0f / 60.0f;
   for (int frame = 0; frame < 6; ++frame) {
     pose.position.z() += 20.0f * dt;
@@ -94,7 +99,8 @@ TEST_P(FastHull, At20MetresPerSecondLeavesNoParticleInside) {
     ASSERT_TRUE(cape.state().positions.allFinite());
     EXPECT_LE(worstDepth(cape.state().positions, colliders), 1e-4f) << "frame " << frame;
     if (slab && pose.position.z() > 0.0f) {
-      EXPECT_GE(cape.state().positions.col(2).minCoeff(), pose.position.z() + 0.01f - 1e-4f) << "frame " << frame;
+      EXPECT_GE(cape.state().positions.col(2).minCoeff(), pose.position.z() + 0.01f - 1e-4f)
+          << "frame " << frame;
     }
   }
 }
@@ -112,9 +118,9 @@ std::shared_ptr<TriangleSoup> floorSoup() {
 /// A cape lying flat (grid (x, y, 0) -> world (x, height, -y)) thrown down at `speed` onto a mesh floor
 /// tilted by `tilt` rad about Z, with the floor's own friction; returns the cape after `seconds`.
 struct DropResult {
-  float lowest;          ///< m, the lowest particle height above the floor's plane, over the run
-  float meanDownhill;    ///< m, how far the cape's centre moved along the slope
-  float lateDownhill;    ///< m, the same over the second half of the run (after the landing)
+  float lowest;        ///< m, the lowest particle height above the floor's plane, over the run
+  float meanDownhill;  ///< m, how far the cape's centre moved along the slope
+  float lateDownhill;  ///< m, the same over the second half of the run (after the landing)
 };
 
 DropResult dropOnMeshFloor(float speed, float tilt, float floorFriction, float seconds) {
@@ -124,7 +130,8 @@ DropResult dropOnMeshFloor(float speed, float tilt, float floorFriction, float s
   s.friction = 0.9f;  // the cape's own setting: the floor's must win
   const Quat slope(Eigen::AngleAxisf(tilt, Vec3::UnitZ()));
   const Pose floorPose{Vec3(0.0f, 0.0f, 0.0f), slope};
-  const Pose start{slope * Vec3(-0.25f, 0.3f, 0.25f), slope * Quat(Eigen::AngleAxisf(-kPi / 2.0f, Vec3::UnitX()))};
+  const Pose start{slope * Vec3(-0.25f, 0.3f, 0.25f),
+                   slope * Quat(Eigen::AngleAxisf(-kPi / 2.0f, Vec3::UnitX()))};
   Cape cape(fabric, s, start);
   EXPECT_TRUE(cape.ok());
   cape.mutableState().velocities.rowwise() = (slope * Vec3(0.0f, -speed, 0.0f)).transpose();
@@ -192,7 +199,8 @@ TEST(TriangleMeshCollider, AThinWallOfOneTriangleCannotBePassedAt20MetresPerSeco
 TEST(TriangleMeshCollider, AnEmptyMeshOrNoSoupIsHarmless) {
   FabricPtr fabric = makeGrid(4, 4);
   Cape cape(fabric, test::quietSettings());
-  std::vector<Collider> colliders{Collider::triangleMesh(std::make_shared<TriangleSoup>()), Collider::triangleMesh(nullptr)};
+  std::vector<Collider> colliders{Collider::triangleMesh(std::make_shared<TriangleSoup>()),
+                                  Collider::triangleMesh(nullptr)};
   EXPECT_FALSE(colliders[1].validate().ok());
   for (int f = 0; f < 3; ++f) cape.step(1.0f / 60.0f, colliders);
   EXPECT_TRUE(cape.state().positions.allFinite());

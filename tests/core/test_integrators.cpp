@@ -26,7 +26,8 @@ TEST(Integrators, UnpinnedCapeFallsFreely) {
   const float h = ctx.frameTime() / 4.0f;
   const Points& x = ctx.cape().state().positions;
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
-    const Vec3 expected = CapeTestContext::predictPosition(row(x0, i), Vec3::Zero(), s.gravity, s.damping, h, 120);
+    const Vec3 expected =
+        CapeTestContext::predictPosition(row(x0, i), Vec3::Zero(), s.gravity, s.damping, h, 120);
     EXPECT_NEAR((row(x, i) - expected).norm(), 0.0f, 1e-4f) << "particle " << i;
   }
   // And it did fall: about g t^2 / 2 less the damping, over a metre.
@@ -39,8 +40,8 @@ struct StripCase {
 };
 
 // A 2 x R strip hung from its two top particles, shear and bend off, no tethers, no colliders: two
-// independent chains joined by rungs that stay at rest length by symmetry. Spring j of a column (from row j to
-// row j + 1) carries the weight of the R - 1 - j particles below it, so at equilibrium it is stretched by
+// independent chains joined by rungs that stay at rest length by symmetry. Spring j of a column (from row j
+// to row j + 1) carries the weight of the R - 1 - j particles below it, so at equilibrium it is stretched by
 // e_j = (R - 1 - j) m g / k. XPBD with compliance 1/k has the same fixed point (the tension per substep is
 // lambda / h^2), up to a Gauss-Seidel error of order w k h^2.
 class HangingStrip : public ::testing::TestWithParam<StripCase> {};
@@ -86,13 +87,15 @@ TEST_P(HangingStrip, SettlesAtTheAnalyticExtension) {
   }
   // At rest: what speed is left is float round-off. Velocities are position changes over a substep, so a
   // one-ulp change of a coordinate near 1 m reads as eps / h (1.4e-4 m/s at 20 substeps of 1/60 s).
-  const float quantum = std::numeric_limits<float>::epsilon() / (ctx.frameTime() / static_cast<float>(s.substeps));
+  const float quantum =
+      std::numeric_limits<float>::epsilon() / (ctx.frameTime() / static_cast<float>(s.substeps));
   EXPECT_LT(cape.state().velocities.rowwise().norm().mean(), 5.0f * quantum);
   EXPECT_LT(cape.state().velocities.rowwise().norm().maxCoeff(), 30.0f * quantum);
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, HangingStrip,
-                         ::testing::Values(StripCase{Integrator::Xpbd, 20}, StripCase{Integrator::ExplicitSpring, 4}),
+                         ::testing::Values(StripCase{Integrator::Xpbd, 20},
+                                           StripCase{Integrator::ExplicitSpring, 4}),
                          [](const auto& info) { return std::string(toString(info.param.integrator)); });
 
 // Symplectic Euler conserves a shadow Hamiltonian within O(h omega) of the true energy: with no damping the
@@ -139,7 +142,8 @@ TEST(Integrators, UndampedExplicitEnergyStaysBounded) {
   ASSERT_TRUE(cape.state().positions.allFinite());
   EXPECT_GT(maxKinetic, 0.2 * e0) << "the cape must actually oscillate for the test to mean anything";
   EXPECT_LT(maxDeviation, 0.03 * e0) << "E0 = " << e0;
-  EXPECT_LT(std::abs(lastMean - firstMean), 0.005 * e0) << "energy drifts: first mean " << firstMean << ", last mean " << lastMean;
+  EXPECT_LT(std::abs(lastMean - firstMean), 0.005 * e0)
+      << "energy drifts: first mean " << firstMean << ", last mean " << lastMean;
 }
 
 }  // namespace

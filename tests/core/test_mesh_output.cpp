@@ -32,7 +32,7 @@ TEST(CapeMesh, NormalsAreAreaWeighted) {
   // Two triangles sharing vertex 0: a big one in the z = 0 plane (area 2) and a small one in the x = 0 plane
   // (area 0.5, normal +X). Vertex 0's normal is the normalised sum of 2 * area * unit normal.
   Points x(5, 3);
-  x << 0, 0, 0,  2, 0, 0,  0, 2, 0,  0, 0, 1,  0, 1, 0;
+  x << 0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 1, 0, 1, 0;
   const std::vector<std::uint32_t> tri{0, 1, 2, 0, 4, 3};
   Points n(5, 3);
   computeVertexNormals(x, tri, n);

@@ -19,13 +19,13 @@ TEST(Metrics, StrainOfAUniformStretch) {
   const StrainStats s = structuralStrain(*f, x);
   EXPECT_NEAR(s.max, 0.1f, 1e-5f);
   EXPECT_NEAR(s.mean, 0.05f, 1e-5f);  // as many row springs as column springs in a square grid
-  x = f->restPositions() * 0.9f;       // compression is negative strain
+  x = f->restPositions() * 0.9f;      // compression is negative strain
   EXPECT_NEAR(structuralStrain(*f, x).max, -0.1f, 1e-5f);
 }
 
 TEST(Metrics, PenetrationIsDepthInsideTheTrueSurface) {
   Points x(3, 3);
-  x << 0.0f, 0.0f, 0.0f,  0.0f, 0.45f, 0.0f,  2.0f, 0.0f, 0.0f;
+  x << 0.0f, 0.0f, 0.0f, 0.0f, 0.45f, 0.0f, 2.0f, 0.0f, 0.0f;
   std::vector<Collider> c{Collider::sphere(0.5f), Collider::plane(Vec3::UnitY(), -1.0f)};
   EXPECT_NEAR(maxPenetration(x, c), 0.5f, 1e-6f);  // the centre is 0.5 m deep
   x.row(0) << 0.0f, 0.499f, 0.0f;
@@ -77,7 +77,7 @@ TEST(Metrics, SelfIntersectionsOfAFlatAndAFoldedCape) {
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
     const float y = x(i, 1);
     if (y < -0.5f) {
-      x(i, 1) = -1.0f - y;           // mirrored above the fold line
+      x(i, 1) = -1.0f - y;                // mirrored above the fold line
       x(i, 2) = 0.3f * (x(i, 0) - 0.5f);  // tilted about the x = 0.5 line: crosses z = 0
     }
   }
@@ -151,7 +151,8 @@ TEST(Metrics, OneMeasureFrameForEverySolver) {
 
   Points far = st.positions;
   far(3, 1) = std::nanf("");
-  const FrameMetrics blown = measureFrame(cape.fabric(), far, st.velocities, st.pins, body, Vec3::Zero(), &c2);
+  const FrameMetrics blown =
+      measureFrame(cape.fabric(), far, st.velocities, st.pins, body, Vec3::Zero(), &c2);
   EXPECT_TRUE(blown.blowUp);
   EXPECT_EQ(blown.maxStrain, 0.0f);
   EXPECT_EQ(blown.meanSpeed, 0.0f);

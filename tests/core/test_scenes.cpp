@@ -14,7 +14,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 TEST(Scenes, ParseNames) {
   SceneKind k;
-  for (SceneKind kind : {SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind, SceneKind::Crowd}) {
+  for (SceneKind kind :
+       {SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind, SceneKind::Crowd}) {
     ASSERT_TRUE(parseSceneKind(toString(kind), k));
     EXPECT_EQ(k, kind);
   }
@@ -85,7 +86,8 @@ TEST(Scenes, CapeRigs) {
   EXPECT_EQ(collar.pinnedParticles.size(), 20u);
 }
 
-RunSummary runScene(SceneKind kind, int n = 20, double seconds = -1.0, const CapeSettings& settings = CapeSettings()) {
+RunSummary runScene(SceneKind kind, int n = 20, double seconds = -1.0,
+                    const CapeSettings& settings = CapeSettings()) {
   SimpleScene scene(kind, n, PinLayout::Corners, settings);
   EXPECT_TRUE(scene.status().ok());
   MetricsRecorder rec;
@@ -125,7 +127,8 @@ TEST(Scenes, StrainAdaptiveSubstepsHoldTheSprintTurn) {
   fixed.strainLimit = 0.0f;
   const RunSummary plain = runScene(SceneKind::SprintTurn, 20, -1.0, fixed);
   EXPECT_LE(adaptive.p95FrameMaxStrain, 0.15f);
-  EXPECT_GT(plain.p95FrameMaxStrain, 2.0f * adaptive.p95FrameMaxStrain) << "the refinement must be what helps";
+  EXPECT_GT(plain.p95FrameMaxStrain, 2.0f * adaptive.p95FrameMaxStrain)
+      << "the refinement must be what helps";
   // Walking never needs it: the cape ends the walk back at the settings' substeps.
   SimpleScene walk(SceneKind::Walk, 20, PinLayout::Corners, CapeSettings());
   for (int f = 0; f < 120; ++f) walk.advanceFrame();

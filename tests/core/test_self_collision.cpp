@@ -30,7 +30,8 @@ struct TwoLayers {
         const Vec3 r = test::row(grid->restPositions(), i);
         d.positions.push_back(Vec3(r.x(), 0.04f * static_cast<float>(layer), r.y()));  // flat in y
       }
-      for (std::uint32_t v : grid->triangles()) d.triangles.push_back(v + static_cast<std::uint32_t>(layer * n));
+      for (std::uint32_t v : grid->triangles())
+        d.triangles.push_back(v + static_cast<std::uint32_t>(layer * n));
     }
     d.totalMass = 0.1f;
     FabricResult r = Fabric::fromMesh(d);
@@ -83,7 +84,8 @@ int dropOnto(const Collider& collider, bool selfCollision) {
   s.selfCollision = selfCollision;
   GridDesc g;
   FabricResult fabric = Fabric::grid(g);
-  Cape cape(fabric.fabric, s, Pose{Vec3(-0.3f, 0.5f, -0.5f), Quat(Eigen::AngleAxisf(-kPi / 2.0f, Vec3::UnitX()))});
+  Cape cape(fabric.fabric, s,
+            Pose{Vec3(-0.3f, 0.5f, -0.5f), Quat(Eigen::AngleAxisf(-kPi / 2.0f, Vec3::UnitX()))});
   EXPECT_TRUE(cape.ok());
   std::vector<Collider> colliders{collider, Collider::plane(Vec3::UnitY(), 0.0f)};
   SelfIntersectionCounter counter;
@@ -114,10 +116,12 @@ TEST(SelfCollision, CapeCrumpledOntoASphereKeepsZeroSelfIntersections) {
 TEST(SelfCollision, TheSearchFindsEveryNearPairThatBruteForceFinds) {
   CapeSettings s;
   s.selfCollision = true;
-  Cape cape(test::makeGrid(20, 20), s, Pose{Vec3(-0.3f, 0.5f, -0.5f), Quat(Eigen::AngleAxisf(-kPi / 2.0f, Vec3::UnitX()))});
+  Cape cape(test::makeGrid(20, 20), s,
+            Pose{Vec3(-0.3f, 0.5f, -0.5f), Quat(Eigen::AngleAxisf(-kPi / 2.0f, Vec3::UnitX()))});
   ASSERT_TRUE(cape.ok());
-  const std::vector<Collider> colliders{Collider::capsule(0.03f, 0.5f, 0, Pose{Vec3(0.0f, 0.3f, 0.0f), Quat::Identity()}),
-                                        Collider::plane(Vec3::UnitY(), 0.0f)};
+  const std::vector<Collider> colliders{
+      Collider::capsule(0.03f, 0.5f, 0, Pose{Vec3(0.0f, 0.3f, 0.0f), Quat::Identity()}),
+      Collider::plane(Vec3::UnitY(), 0.0f)};
   // Each triangle's local particles: its corners and the far corners of the triangles across its edges.
   const std::vector<std::uint32_t>& tri = cape.fabric().triangles();
   const std::size_t triangles = tri.size() / 3;
@@ -153,7 +157,8 @@ TEST(SelfCollision, TheSearchFindsEveryNearPairThatBruteForceFinds) {
     std::vector<Vec3> centroid(triangles);
     std::vector<float> radius(triangles);
     for (std::size_t t = 0; t < triangles; ++t) {
-      const Vec3 a = test::row(start, tri[3 * t]), b = test::row(start, tri[3 * t + 1]), c = test::row(start, tri[3 * t + 2]);
+      const Vec3 a = test::row(start, tri[3 * t]), b = test::row(start, tri[3 * t + 1]),
+                 c = test::row(start, tri[3 * t + 2]);
       centroid[t] = (a + b + c) / 3.0f;
       radius[t] = std::max({(a - centroid[t]).norm(), (b - centroid[t]).norm(), (c - centroid[t]).norm()});
     }
@@ -162,7 +167,8 @@ TEST(SelfCollision, TheSearchFindsEveryNearPairThatBruteForceFinds) {
       for (std::size_t t = 0; t < triangles; ++t) {
         if ((p - centroid[t]).norm() > reach + radius[t] + 1e-4f) continue;
         if (local[t].count(static_cast<std::uint32_t>(q)) != 0) continue;
-        const Vec3 a = test::row(start, tri[3 * t]), b = test::row(start, tri[3 * t + 1]), c = test::row(start, tri[3 * t + 2]);
+        const Vec3 a = test::row(start, tri[3 * t]), b = test::row(start, tri[3 * t + 1]),
+                   c = test::row(start, tri[3 * t + 2]);
         const TriangleNearest w = nearestOnTriangle(p, a, b, c);
         if ((p - (w.wa * a + w.wb * b + w.wc * c)).norm() > reach) continue;
         ++pairsWithin;
@@ -196,7 +202,8 @@ TEST(SelfCollision, AWingOfOneHalfOfACellFoldedOntoTheOtherHalfIsAContact) {
   x.row(5) = (over + Vec3(0.1f, 0.0f, 0.0f)).transpose();
   cape.step(1.0f / 60.0f, {});
   bool found = false;
-  for (const Cape::SelfContact& k : cape.selfContacts()) found = found || (k.particle == 4 && k.triangle == 1);
+  for (const Cape::SelfContact& k : cape.selfContacts())
+    found = found || (k.particle == 4 && k.triangle == 1);
   EXPECT_TRUE(found) << "particle 4 folded onto triangle 1 is not a contact";
 }
 
@@ -320,7 +327,8 @@ TEST_P(SelfCollisionScenes, ZeroSelfIntersectionsInEveryFrame) {
 }
 
 INSTANTIATE_TEST_SUITE_P(SelfCollision, SelfCollisionScenes,
-                         ::testing::Values(SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind),
+                         ::testing::Values(SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn,
+                                           SceneKind::Wind),
                          [](const auto& info) {
                            std::string name = toString(info.param);
                            name.erase(std::remove(name.begin(), name.end(), '-'), name.end());

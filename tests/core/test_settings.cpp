@@ -15,7 +15,8 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 void expectRejected(const CapeSettings& s, const char* field) {
   const Status st = s.validate();
   EXPECT_FALSE(st.ok()) << field;
-  EXPECT_NE(st.message().find(field), std::string::npos) << "message should name " << field << ": " << st.message();
+  EXPECT_NE(st.message().find(field), std::string::npos)
+      << "message should name " << field << ": " << st.message();
 }
 
 TEST(Settings, DefaultsAndSeedAreValid) {
@@ -29,32 +30,74 @@ TEST(Settings, DefaultsAndSeedAreValid) {
 
 TEST(Settings, RejectsBadValues) {
   CapeSettings s;
-  s.structuralStiffness = 0.0f;   expectRejected(s, "structuralStiffness");
-  s = {}; s.structuralStiffness = kNaN; expectRejected(s, "structuralStiffness");
-  s = {}; s.shearStiffness = -1.0f;     expectRejected(s, "shearStiffness");
-  s = {}; s.bendStiffness = kNaN;       expectRejected(s, "bendStiffness");
-  s = {}; s.damping = -0.1f;            expectRejected(s, "damping");
-  s = {}; s.damping = kInf;             expectRejected(s, "damping");
-  s = {}; s.collisionThickness = -0.01f; expectRejected(s, "collisionThickness");
-  s = {}; s.friction = kNaN;            expectRejected(s, "friction");
-  s = {}; s.substeps = 0;               expectRejected(s, "substeps");
-  s = {}; s.iterations = -3;            expectRejected(s, "iterations");
-  s = {}; s.gravity.y() = kNaN;         expectRejected(s, "gravity");
-  s = {}; s.timeStep = 0.0f;            expectRejected(s, "timeStep");
-  s = {}; s.integrator = Integrator::ExplicitSpring; s.structuralStiffness = kInf; expectRejected(s, "finite stiffness");
-  s = {}; s.wind.model = WindSettings::Model::Aerodynamic; s.wind.direction = Vec3::Zero(); expectRejected(s, "wind");
+  s.structuralStiffness = 0.0f;
+  expectRejected(s, "structuralStiffness");
+  s = {};
+  s.structuralStiffness = kNaN;
+  expectRejected(s, "structuralStiffness");
+  s = {};
+  s.shearStiffness = -1.0f;
+  expectRejected(s, "shearStiffness");
+  s = {};
+  s.bendStiffness = kNaN;
+  expectRejected(s, "bendStiffness");
+  s = {};
+  s.damping = -0.1f;
+  expectRejected(s, "damping");
+  s = {};
+  s.damping = kInf;
+  expectRejected(s, "damping");
+  s = {};
+  s.collisionThickness = -0.01f;
+  expectRejected(s, "collisionThickness");
+  s = {};
+  s.friction = kNaN;
+  expectRejected(s, "friction");
+  s = {};
+  s.substeps = 0;
+  expectRejected(s, "substeps");
+  s = {};
+  s.iterations = -3;
+  expectRejected(s, "iterations");
+  s = {};
+  s.gravity.y() = kNaN;
+  expectRejected(s, "gravity");
+  s = {};
+  s.timeStep = 0.0f;
+  expectRejected(s, "timeStep");
+  s = {};
+  s.integrator = Integrator::ExplicitSpring;
+  s.structuralStiffness = kInf;
+  expectRejected(s, "finite stiffness");
+  s = {};
+  s.wind.model = WindSettings::Model::Aerodynamic;
+  s.wind.direction = Vec3::Zero();
+  expectRejected(s, "wind");
 }
 
 TEST(Settings, FabricsRejectDegenerateInput) {
   GridDesc g;
   g.columns = 1;
   EXPECT_FALSE(Fabric::grid(g).status.ok());
-  g = {}; g.totalMass = 0.0f;  EXPECT_FALSE(Fabric::grid(g).status.ok());
-  g = {}; g.totalMass = -1.0f; EXPECT_FALSE(Fabric::grid(g).status.ok());
-  g = {}; g.width = kNaN;      EXPECT_FALSE(Fabric::grid(g).status.ok());
-  g = {}; g.height = 0.0f;     EXPECT_FALSE(Fabric::grid(g).status.ok());
-  g = {}; g.tetherAnchors = {100000}; EXPECT_FALSE(Fabric::grid(g).status.ok());
-  g = {}; g.tetherAnchors = {0}; g.tetherScale = 0.5f; EXPECT_FALSE(Fabric::grid(g).status.ok());
+  g = {};
+  g.totalMass = 0.0f;
+  EXPECT_FALSE(Fabric::grid(g).status.ok());
+  g = {};
+  g.totalMass = -1.0f;
+  EXPECT_FALSE(Fabric::grid(g).status.ok());
+  g = {};
+  g.width = kNaN;
+  EXPECT_FALSE(Fabric::grid(g).status.ok());
+  g = {};
+  g.height = 0.0f;
+  EXPECT_FALSE(Fabric::grid(g).status.ok());
+  g = {};
+  g.tetherAnchors = {100000};
+  EXPECT_FALSE(Fabric::grid(g).status.ok());
+  g = {};
+  g.tetherAnchors = {0};
+  g.tetherScale = 0.5f;
+  EXPECT_FALSE(Fabric::grid(g).status.ok());
   g = {};
   g.columns = g.rows = 1;
   const FabricResult bad = Fabric::grid(g);

@@ -22,11 +22,13 @@ FabricPtr meshFabric() {
   MeshDesc d;
   const int nc = 9, nr = 7;
   for (int r = 0; r < nr; ++r)
-    for (int c = 0; c < nc; ++c) d.positions.emplace_back(0.1f * static_cast<float>(c), -0.1f * static_cast<float>(r), 0.0f);
+    for (int c = 0; c < nc; ++c)
+      d.positions.emplace_back(0.1f * static_cast<float>(c), -0.1f * static_cast<float>(r), 0.0f);
   for (int r = 0; r + 1 < nr; ++r) {
     for (int c = 0; c + 1 < nc; ++c) {
       const auto id = [nc](int rr, int cc) { return static_cast<std::uint32_t>(rr * nc + cc); };
-      d.triangles.insert(d.triangles.end(), {id(r + 1, c), id(r + 1, c + 1), id(r, c + 1), id(r + 1, c), id(r, c + 1), id(r, c)});
+      d.triangles.insert(d.triangles.end(), {id(r + 1, c), id(r + 1, c + 1), id(r, c + 1), id(r + 1, c),
+                                             id(r, c + 1), id(r, c)});
     }
   }
   d.tetherAnchors = {0, static_cast<std::uint32_t>(nc - 1)};
@@ -61,8 +63,10 @@ bool followsLayout(const SpringSet& set, std::size_t s, SpringLayout layout) {
       case SpringLayout::Pairs:
         if (f(k) != p + pairOffset[k] || g(k) != f(k) + 2) return false;
         break;
-      case SpringLayout::Gathered: break;
-      case SpringLayout::Scalar: return false;
+      case SpringLayout::Gathered:
+        break;
+      case SpringLayout::Scalar:
+        return false;
     }
   }
   return true;
@@ -82,8 +86,10 @@ TEST(SpringRuns, CoverEverySpringOnceInOrderWithEveryBlockInsideOneColourAndItsL
         ASSERT_EQ((run.end - run.begin) % 4, 0u);
         for (std::uint32_t s = run.begin; s < run.end; s += 4) {
           // Inside one colour, and so four distinct particles at each end and none shared.
-          const auto colour = std::upper_bound(set.colourStart.begin(), set.colourStart.end(), s) - set.colourStart.begin();
-          EXPECT_LE(s + 4, set.colourStart[static_cast<std::size_t>(colour)]) << "block at " << s << " straddles colours";
+          const auto colour =
+              std::upper_bound(set.colourStart.begin(), set.colourStart.end(), s) - set.colourStart.begin();
+          EXPECT_LE(s + 4, set.colourStart[static_cast<std::size_t>(colour)])
+              << "block at " << s << " straddles colours";
           std::set<std::uint32_t> particles;
           for (std::uint32_t k = 0; k < 4; ++k) particles.insert({set.first[s + k], set.second[s + k]});
           EXPECT_EQ(particles.size(), 8u) << "block at " << s;
@@ -104,9 +110,11 @@ TEST(SpringRuns, MostOfTheSeedGridsSpringsAreReadWithContiguousLoads) {
     const SpringSet& set = fabric->springs(static_cast<SpringFamily>(family));
     total += set.size();
     for (const SpringRun& run : set.runs)
-      if (run.layout != SpringLayout::Scalar && run.layout != SpringLayout::Gathered) structured += run.end - run.begin;
+      if (run.layout != SpringLayout::Scalar && run.layout != SpringLayout::Gathered)
+        structured += run.end - run.begin;
   }
-  EXPECT_GE(static_cast<double>(structured), 0.75 * static_cast<double>(total)) << structured << " of " << total;
+  EXPECT_GE(static_cast<double>(structured), 0.75 * static_cast<double>(total))
+      << structured << " of " << total;
 }
 
 // A cape's worth of state: the rest positions jittered, a few particles pinned, two made to coincide with a

@@ -21,10 +21,14 @@ struct StoredScene {
 // 20 x 20 canonical cape, corner attachment, default settings, 180 frames of 1/60 s (a sprint-turn's first
 // turn is in frames 90..120).
 constexpr StoredScene kStored[] = {
-    {SceneKind::Hang, false, 0x36e983342aa5d54bull},       {SceneKind::Hang, true, 0x36e983342aa5d54bull},
-    {SceneKind::Walk, false, 0xe42e25e81ef47c26ull},       {SceneKind::Walk, true, 0xe42e25e81ef47c26ull},
-    {SceneKind::SprintTurn, false, 0xe4943c86c51ce854ull}, {SceneKind::SprintTurn, true, 0xd29ff20f3bcb0175ull},
-    {SceneKind::Wind, false, 0x7132717a08c6698aull},       {SceneKind::Wind, true, 0x6fafb93a52a5ffc7ull},
+    {SceneKind::Hang, false, 0x36e983342aa5d54bull},
+    {SceneKind::Hang, true, 0x36e983342aa5d54bull},
+    {SceneKind::Walk, false, 0xe42e25e81ef47c26ull},
+    {SceneKind::Walk, true, 0xe42e25e81ef47c26ull},
+    {SceneKind::SprintTurn, false, 0xe4943c86c51ce854ull},
+    {SceneKind::SprintTurn, true, 0xd29ff20f3bcb0175ull},
+    {SceneKind::Wind, false, 0x7132717a08c6698aull},
+    {SceneKind::Wind, true, 0x6fafb93a52a5ffc7ull},
 };
 
 std::uint64_t runScene(SceneKind kind, bool selfCollision) {

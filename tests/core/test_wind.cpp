@@ -16,10 +16,12 @@ constexpr float kRho = 1.2f;
 
 /// The canonical cape's grid as a mesh fabric: masses by area, so mass per area is uniform to the edges (a
 /// grid spreads mass evenly over particles, giving edge particles twice their area's share).
-FabricPtr uniformSheet(int n, float width, float height, float mass, std::vector<std::uint32_t> anchors = {}) {
+FabricPtr uniformSheet(int n, float width, float height, float mass,
+                       std::vector<std::uint32_t> anchors = {}) {
   FabricPtr grid = test::makeGrid(n, n, width, height, mass, false);
   MeshDesc d;
-  for (Eigen::Index i = 0; i < grid->restPositions().rows(); ++i) d.positions.push_back(test::row(grid->restPositions(), i));
+  for (Eigen::Index i = 0; i < grid->restPositions().rows(); ++i)
+    d.positions.push_back(test::row(grid->restPositions(), i));
   d.triangles = grid->triangles();
   d.totalMass = mass;
   d.bendSprings = true;
@@ -78,7 +80,8 @@ TEST(Wind, HorizontalCapeReachesTheTerminalSpeedDragPredicts) {
   const float measured = -cape.state().velocities.col(1).mean();
   EXPECT_NEAR(measured, predicted, 0.05f * predicted) << "predicted " << predicted << " m/s";
   // It fell flat: no sideways drift to speak of.
-  EXPECT_LT(cape.state().velocities.col(0).cwiseAbs().maxCoeff() + cape.state().velocities.col(2).cwiseAbs().maxCoeff(),
+  EXPECT_LT(cape.state().velocities.col(0).cwiseAbs().maxCoeff() +
+                cape.state().velocities.col(2).cwiseAbs().maxCoeff(),
             0.05f * predicted);
 }
 
@@ -104,8 +107,8 @@ TEST(Wind, SteadyWindDeflectsAHangingCapeByTheForceBalanceAngle) {
   const Eigen::Index topMid = n / 2, hemMid = (n - 1) * n + n / 2;
   const Vec3 d = test::row(x, hemMid) - test::row(x, topMid);
   const float measured = std::atan2(d.z(), -d.y());
-  EXPECT_NEAR(measured, predicted, 0.10f * predicted) << "predicted " << predicted * 180 / kPi << " deg, measured "
-                                                      << measured * 180 / kPi;
+  EXPECT_NEAR(measured, predicted, 0.10f * predicted)
+      << "predicted " << predicted * 180 / kPi << " deg, measured " << measured * 180 / kPi;
   // Straight, as the balance says: the middle particle lies on the line from top to hem.
   const Vec3 mid = test::row(x, (n / 2) * n + n / 2) - test::row(x, topMid);
   EXPECT_LT(mid.cross(d.normalized()).norm(), 0.02f);

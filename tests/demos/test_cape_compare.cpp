@@ -24,7 +24,8 @@ TEST(CapeCompare, WalkWritesOneRowPerSolverAndPlots) {
   const Result r = run(kCompare + " --scene walk --size 8 --seconds 0.5 --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find("btSoftBody"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("piterations"), std::string::npos) << "prints the btSoftBody settings: " << r.output;
+  EXPECT_NE(r.output.find("piterations"), std::string::npos)
+      << "prints the btSoftBody settings: " << r.output;
 
   std::ifstream in(dir / "compare.json");
   const json j = json::parse(in);
@@ -32,9 +33,9 @@ TEST(CapeCompare, WalkWritesOneRowPerSolverAndPlots) {
   ASSERT_EQ(j["solvers"].size(), 2u);
   EXPECT_NE(j["solvers"][0]["name"].get<std::string>().find("ours"), std::string::npos) << "ours first";
   for (const json& s : j["solvers"]) {
-    for (const char* key : {"name", "frame_time_us_median", "cape_time_us_median", "cape_time_us_p95", "max_strain",
-                            "mean_strain", "max_penetration_m", "frames_penetration_over_1mm", "self_intersections_max",
-                            "pin_error_max_m", "blow_up", "settings"})
+    for (const char* key : {"name", "frame_time_us_median", "cape_time_us_median", "cape_time_us_p95",
+                            "max_strain", "mean_strain", "max_penetration_m", "frames_penetration_over_1mm",
+                            "self_intersections_max", "pin_error_max_m", "blow_up", "settings"})
       EXPECT_TRUE(s.contains(key)) << key;
     EXPECT_FALSE(s["blow_up"].get<bool>());
     EXPECT_GT(s["frame_time_us_median"].get<double>(), 0.0);
@@ -47,15 +48,18 @@ TEST(CapeCompare, WalkWritesOneRowPerSolverAndPlots) {
   EXPECT_EQ(lines(dir / "compare.csv").size(), 3u);
   EXPECT_EQ(lines(dir / "frames_ours.csv").size(), 31u);
   EXPECT_EQ(lines(dir / "frames_btsoftbody.csv").size(), 31u);
-  for (const char* png : {"strain.png", "penetration.png", "frame_time.png"}) EXPECT_TRUE(isPng(dir / png)) << png;
+  for (const char* png : {"strain.png", "penetration.png", "frame_time.png"})
+    EXPECT_TRUE(isPng(dir / png)) << png;
 }
 
 // With --with-deformable a third row: the twin in Bullet's deformable world, with its own settings
 // (the stiffness asked for) and per-frame CSV; it hangs on its pins without blowing up.
 TEST(CapeCompare, WithDeformableAddsBulletsDeformableWorld) {
   const fs::path dir = freshDir();
-  const Result r = run(kCompare + " --scene walk --size 10 --seconds 0.5 --no-plots --with-deformable "
-                                  "--deformable-stiffness 40 --out " + dir.string());
+  const Result r = run(kCompare +
+                       " --scene walk --size 10 --seconds 0.5 --no-plots --with-deformable "
+                       "--deformable-stiffness 40 --out " +
+                       dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find("btDeformable twin"), std::string::npos) << r.output;
   std::ifstream in(dir / "compare.json");
@@ -70,12 +74,17 @@ TEST(CapeCompare, WithDeformableAddsBulletsDeformableWorld) {
   EXPECT_EQ(lines(dir / "compare.csv").size(), 4u);
   EXPECT_EQ(lines(dir / "frames_deformable.csv").size(), 31u);
   // The stiffness must be positive.
-  EXPECT_NE(run(kCompare + " --with-deformable --deformable-stiffness 0 --seconds 0.1 --out " + freshDir().string()).exitCode, 0);
+  EXPECT_NE(
+      run(kCompare + " --with-deformable --deformable-stiffness 0 --seconds 0.1 --out " + freshDir().string())
+          .exitCode,
+      0);
 }
 
 TEST(CapeCompare, SimpleBodyAndNoPlots) {
   const fs::path dir = freshDir();
-  const Result r = run(kCompare + " --simple-body --scene sprint-turn --size 6 --seconds 0.25 --no-plots --out " + dir.string());
+  const Result r =
+      run(kCompare + " --simple-body --scene sprint-turn --size 6 --seconds 0.25 --no-plots --out " +
+          dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir / "compare.json"));
   EXPECT_FALSE(fs::exists(dir / "strain.png"));
@@ -83,20 +92,22 @@ TEST(CapeCompare, SimpleBodyAndNoPlots) {
 
 TEST(CapeCompare, RendersBothCapesSideBySide) {
   const fs::path dir = freshDir();
-  const Result r = run(kCompare + " --size 8 --seconds 0.25 --no-plots --render " + (dir / "frames").string() +
-                       " --render-size 160x60 --out " + dir.string());
+  const Result r = run(kCompare + " --size 8 --seconds 0.25 --no-plots --render " +
+                       (dir / "frames").string() + " --render-size 160x60 --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   int pngs = 0;
   for (const auto& e : fs::directory_iterator(dir / "frames")) pngs += e.path().extension() == ".png" ? 1 : 0;
   EXPECT_EQ(pngs, 15);
   EXPECT_TRUE(isPng(dir / "frames" / "00015.png"));
-  const Result bad = run(kCompare + " --seconds 0.1 --render " + (dir / "x").string() + " --render-size big --out " + dir.string());
+  const Result bad = run(kCompare + " --seconds 0.1 --render " + (dir / "x").string() +
+                         " --render-size big --out " + dir.string());
   EXPECT_NE(bad.exitCode, 0);
 }
 
 TEST(CapeCompare, BadOptionsFailWithAReason) {
   const fs::path dir = freshDir();
-  for (const std::string args : {"--scene dance", "--softbody-iterations 0", "--attach nose", "--urdf /nonexistent.urdf"}) {
+  for (const std::string args :
+       {"--scene dance", "--softbody-iterations 0", "--attach nose", "--urdf /nonexistent.urdf"}) {
     const Result r = run(kCompare + " " + args + " --seconds 0.1 --out " + (dir / "x").string());
     EXPECT_NE(r.exitCode, 0) << args;
     EXPECT_FALSE(r.output.empty()) << args;

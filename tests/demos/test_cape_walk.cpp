@@ -19,7 +19,8 @@ void expectRunFolder(const fs::path& dir, int frames, int n, int characters, int
   ASSERT_EQ(static_cast<int>(csv.size()), frames + 1);
   const auto columns = [](const std::string& l) { return 1 + std::count(l.begin(), l.end(), ','); };
   for (const std::string& l : csv) EXPECT_EQ(columns(l), columns(csv[0]));
-  for (const char* name : {"frame", "max_strain", "mean_strain", "max_penetration_m", "self_intersections", "pin_error_m", "blow_up"})
+  for (const char* name : {"frame", "max_strain", "mean_strain", "max_penetration_m", "self_intersections",
+                           "pin_error_m", "blow_up"})
     EXPECT_NE(csv[0].find(name), std::string::npos) << name << " missing from " << csv[0];
 
   // colliders.jsonl: one object per frame, every collider with its type's fields.
@@ -45,7 +46,8 @@ void expectRunFolder(const fs::path& dir, int frames, int n, int characters, int
     }
   }
 
-  // frames/NNNNN.obj: one per frame (per character in a crowd), n * n vertices, normals, UVs, 2 (n-1)^2 faces.
+  // frames/NNNNN.obj: one per frame (per character in a crowd), n * n vertices, normals, UVs, 2 (n-1)^2
+  // faces.
   for (int k = 0; k < characters; ++k) {
     const fs::path folder = characters > 1 ? dir / "frames" / ("k" + std::to_string(k)) : dir / "frames";
     for (int f : {1, frames}) {
@@ -66,8 +68,9 @@ void expectRunFolder(const fs::path& dir, int frames, int n, int characters, int
   const json s = json::parse(in);
   EXPECT_EQ(s["grid"]["particles"].get<int>(), n * n);
   EXPECT_EQ(s["characters"].get<int>(), characters);
-  for (const char* key : {"frame_time_us_median", "cape_time_us_median", "max_strain", "max_penetration_m",
-                          "frames_penetration_over_1mm", "self_intersections_max", "pin_error_max_m", "blow_up"})
+  for (const char* key :
+       {"frame_time_us_median", "cape_time_us_median", "max_strain", "max_penetration_m",
+        "frames_penetration_over_1mm", "self_intersections_max", "pin_error_max_m", "blow_up"})
     EXPECT_TRUE(s["summary"].contains(key)) << key;
   EXPECT_FALSE(s["summary"]["blow_up"].get<bool>());
 }
@@ -104,13 +107,16 @@ TEST(CapeWalk, UrdfWithNamedAttachmentLinks) {
   <link name="neck"><collision><geometry><sphere radius="0.08"/></geometry></collision></link>
   <joint name="fix" type="fixed"><parent link="base"/><child link="neck"/><origin xyz="0 0 1.52"/></joint>
 </robot>)";
-  Result r = run(kWalk + " --urdf " + urdf.string() + " --scene hang --size 6 --seconds 0.1 --out " + (dir / "a").string());
+  Result r = run(kWalk + " --urdf " + urdf.string() + " --scene hang --size 6 --seconds 0.1 --out " +
+                 (dir / "a").string());
   EXPECT_NE(r.exitCode, 0);
   EXPECT_NE(r.output.find("--attach"), std::string::npos) << "says how to name the links: " << r.output;
-  r = run(kWalk + " --urdf " + urdf.string() + " --attach nose --size 6 --seconds 0.1 --out " + (dir / "b").string());
+  r = run(kWalk + " --urdf " + urdf.string() + " --attach nose --size 6 --seconds 0.1 --out " +
+          (dir / "b").string());
   EXPECT_NE(r.exitCode, 0);
   EXPECT_NE(r.output.find("unknown link \"nose\""), std::string::npos) << r.output;
-  r = run(kWalk + " --urdf " + urdf.string() + " --attach neck --scene hang --size 6 --seconds 0.5 --out " + (dir / "c").string());
+  r = run(kWalk + " --urdf " + urdf.string() + " --attach neck --scene hang --size 6 --seconds 0.5 --out " +
+          (dir / "c").string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   expectRunFolder(dir / "c", 30, 6, 1, 2);
 }
@@ -136,7 +142,8 @@ TEST(CapeWalk, CrowdResultsDoNotDependOnTheThreadCount) {
     for (const std::string& l : lines(out / "metrics.csv")) {
       std::vector<std::string> cells;
       std::size_t start = 0;
-      for (std::size_t comma; (comma = l.find(',', start)) != std::string::npos; start = comma + 1) cells.push_back(l.substr(start, comma - start));
+      for (std::size_t comma; (comma = l.find(',', start)) != std::string::npos; start = comma + 1)
+        cells.push_back(l.substr(start, comma - start));
       cells.push_back(l.substr(start));
       cells.erase(cells.begin() + 2, cells.begin() + 4);
       std::string joined;
@@ -150,7 +157,8 @@ TEST(CapeWalk, CrowdResultsDoNotDependOnTheThreadCount) {
 
 TEST(CapeWalk, CrowdWritesFramesPerCharacter) {
   const fs::path dir = freshDir();
-  const Result r = run(kWalk + " --simple-body --scene crowd --characters 3 --size 6 --seconds 0.25 --out " + dir.string());
+  const Result r = run(kWalk + " --simple-body --scene crowd --characters 3 --size 6 --seconds 0.25 --out " +
+                       dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   expectRunFolder(dir, 15, 6, 3, 5);
 }
@@ -166,19 +174,22 @@ TEST(CapeWalk, NoFramesWritesNoObj) {
 TEST(CapeWalk, HelpListsTheOptions) {
   const Result r = run(kWalk + " --help");
   EXPECT_EQ(r.exitCode, 0);
-  for (const char* option : {"--scene", "--size", "--attachment", "--seconds", "--solver", "--characters", "--threads",
-                             "--out", "--no-frames", "--simple-body", "--urdf", "--attach"})
+  for (const char* option : {"--scene", "--size", "--attachment", "--seconds", "--solver", "--characters",
+                             "--threads", "--out", "--no-frames", "--simple-body", "--urdf", "--attach"})
     EXPECT_NE(r.output.find(option), std::string::npos) << option;
 }
 
 TEST(CapeWalk, BadOptionsFailWithAReason) {
   const fs::path dir = freshDir();
-  for (const std::string args : {"--scene dance", "--size 0", "--seconds -1", "--urdf /nonexistent/robot.urdf",
-                                 "--solver magic", "--attachment belt", "--frobnicate"}) {
+  for (const std::string args :
+       {"--scene dance", "--size 0", "--seconds -1", "--urdf /nonexistent/robot.urdf", "--solver magic",
+        "--attachment belt", "--frobnicate"}) {
     const Result r = run(kWalk + " " + args + " --out " + (dir / "x").string());
     EXPECT_NE(r.exitCode, 0) << args;
     EXPECT_FALSE(r.output.empty()) << args << ": no reason given";
-    EXPECT_LE(std::count(r.output.begin(), r.output.end(), '\n'), 3) << args << ": a short reason, not a dump:\n" << r.output;
+    EXPECT_LE(std::count(r.output.begin(), r.output.end(), '\n'), 3)
+        << args << ": a short reason, not a dump:\n"
+        << r.output;
   }
 }
 

@@ -1,8 +1,8 @@
 // Stored determinism hashes of the Bullet walk, as cape_walk runs it: the shipped humanoid and the simple
 // body, each a 20 x 20 cape pinned by its corners, stepped by stepSimulation(1/60, 8, 1/240) for 2 s, in the
-// walk and, with self-collision (which the walk never needs), the sprint-turn's first turn. The whole path is in them: the character, the adapter's discovery, pins and
-// collider conversion, and the core step. A change of behaviour on purpose updates the table in the same
-// commit, saying why.
+// walk and, with self-collision (which the walk never needs), the sprint-turn's first turn. The whole path is
+// in them: the character, the adapter's discovery, pins and collider conversion, and the core step. A change
+// of behaviour on purpose updates the table in the same commit, saying why.
 #include "DemoTestSupport.h"
 
 #include <nlohmann/json.hpp>
@@ -27,7 +27,8 @@ TEST(StoredHashes, TheBulletWalkKeepsItsBits) {
   int k = 0;
   for (const StoredRun& s : kStored) {
     const std::filesystem::path out = dir / std::to_string(k++);
-    const Result r = run(std::string(CAPE_WALK) + " " + s.arguments + " --seconds 2 --no-frames --out " + out.string());
+    const Result r =
+        run(std::string(CAPE_WALK) + " " + s.arguments + " --seconds 2 --no-frames --out " + out.string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
     std::ifstream in(out / "summary.json");
     const nlohmann::json summary = nlohmann::json::parse(in);

@@ -16,7 +16,9 @@ namespace {
 using cape::demo_test::freshDir;
 using cape::demo_test::Result;
 
-Result runWalk(const std::string& arguments) { return cape::demo_test::run(std::string(CAPE_WALK) + " " + arguments); }
+Result runWalk(const std::string& arguments) {
+  return cape::demo_test::run(std::string(CAPE_WALK) + " " + arguments);
+}
 
 /// Width and height from a PNG's IHDR chunk.
 bool pngSize(const fs::path& file, unsigned& width, unsigned& height) {

@@ -46,7 +46,6 @@ btTransform interpolate(const btTransform& a, const btTransform& b, btScalar s) 
   return btTransform(qa.slerp(qb, s), a.getOrigin().lerp(b.getOrigin(), s));
 }
 
-
 /// Discovery's broadphase query: keeps every proxy the rule accepts, with its object's index in the world's
 /// collision object array. Bullet calls process() only for proxies in its broadphase, i.e. for objects in
 /// the world, so reading the object here is safe.
@@ -287,8 +286,7 @@ void CapeAction::discover(btCollisionWorld* world) {
   world->getBroadphase()->aabbTest(query.lo, query.hi, query);
   // The broadphase reports in its trees' order: the world's array order makes the objects first seen in
   // this step follow (and collide) in the same order whatever the trees look like.
-  std::sort(found_.begin(), found_.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(found_.begin(), found_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   found_.erase(std::unique(found_.begin(), found_.end(),
                            [](const auto& a, const auto& b) { return a.first == b.first; }),
                found_.end());
@@ -404,7 +402,8 @@ void CapeAction::buildColliders() {
       for (const std::string& name : t.shape.unsupported)
         warnOnce("shape:" + name, "unsupported collision shape '" + name + "' ignored by the cape");
       t.soups.clear();
-      for (std::size_t k = 0; k < t.shape.meshes.size(); ++k) t.soups.push_back(std::make_shared<TriangleSoup>());
+      for (std::size_t k = 0; k < t.shape.meshes.size(); ++k)
+        t.soups.push_back(std::make_shared<TriangleSoup>());
     }
     if (t.shape.empty()) continue;
     activeObjects_.push_back(t.object);
@@ -437,8 +436,8 @@ void CapeAction::buildColliders() {
   }
 }
 
-void CapeAction::gatherTriangles(const btConcaveShape* shape, const btTransform& start, const btTransform& end,
-                                 TriangleSoup& soup) const {
+void CapeAction::gatherTriangles(const btConcaveShape* shape, const btTransform& start,
+                                 const btTransform& end, TriangleSoup& soup) const {
   // Bullet's mesh query, once per step: the triangles in the box of the cape's bounds grown by the reach of
   // one step (the discovery margin) and the skins, in the shape's frame at the step's start and its end.
   struct Collect : btTriangleCallback {
@@ -450,7 +449,8 @@ void CapeAction::gatherTriangles(const btConcaveShape* shape, const btTransform&
   collect.soup = &soup;
   soup.corners.clear();  // keeps its capacity: no allocation once the cape has met the mesh
   const Points& x = positions();
-  const btScalar grow = btScalar(cape_.settings().collisionThickness) + shape->getMargin() + settings_.discoveryMargin;
+  const btScalar grow =
+      btScalar(cape_.settings().collisionThickness) + shape->getMargin() + settings_.discoveryMargin;
   const btVector3 lo = toBt(Vec3(x.colwise().minCoeff().transpose())) - btVector3(grow, grow, grow);
   const btVector3 hi = toBt(Vec3(x.colwise().maxCoeff().transpose())) + btVector3(grow, grow, grow);
   btVector3 qlo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), qhi = -qlo;

@@ -10,10 +10,10 @@
 #include <BulletCollision/CollisionShapes/btConcaveShape.h>
 #include <BulletCollision/CollisionShapes/btCylinderShape.h>
 #include <BulletCollision/CollisionShapes/btMultiSphereShape.h>
+#include <BulletCollision/CollisionShapes/btPolyhedralConvexShape.h>
 #include <BulletCollision/CollisionShapes/btSphereShape.h>
 #include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
 #include <BulletCollision/CollisionShapes/btTriangleCallback.h>
-#include <BulletCollision/CollisionShapes/btPolyhedralConvexShape.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
 #include <LinearMath/btConvexHullComputer.h>
 
@@ -55,7 +55,8 @@ const std::vector<btVector3>& sampleDirections() {
 void addHull(ShapeConversion& out, const btConvexShape* shape, const btTransform& local) {
   std::shared_ptr<const ConvexHull> hull = convexHullOf(shape);
   if (!hull) {
-    out.unsupported.push_back(std::string(shape->getName()) + " (flat or degenerate: no volume to collide with)");
+    out.unsupported.push_back(std::string(shape->getName()) +
+                              " (flat or degenerate: no volume to collide with)");
     return;
   }
   Collider c = Collider::convexHull(std::move(hull));
@@ -168,12 +169,14 @@ std::shared_ptr<const ConvexHull> convexHullOf(const btConvexShape* shape) {
       points.push_back(v);
     }
   } else {
-    for (const btVector3& d : sampleDirections()) points.push_back(shape->localGetSupportingVertexWithoutMargin(d));
+    for (const btVector3& d : sampleDirections())
+      points.push_back(shape->localGetSupportingVertexWithoutMargin(d));
   }
   for (const btVector3& p : points)
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) return nullptr;
   btConvexHullComputer computer;
-  computer.compute(&points[0].x(), sizeof(btVector3), static_cast<int>(points.size()), btScalar(0), btScalar(0));
+  computer.compute(&points[0].x(), sizeof(btVector3), static_cast<int>(points.size()), btScalar(0),
+                   btScalar(0));
   if (computer.vertices.size() < 4 || computer.faces.size() < 4) return nullptr;
   std::vector<Vec3> vertices;
   Vec3 centre = Vec3::Zero();
@@ -191,7 +194,8 @@ std::shared_ptr<const ConvexHull> convexHullOf(const btConvexShape* shape) {
     do {
       const Eigen::Vector3d a = vertices[std::size_t(e->getSourceVertex())].cast<double>();
       const Eigen::Vector3d b = vertices[std::size_t(e->getTargetVertex())].cast<double>();
-      n += Eigen::Vector3d((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()), (a.x() - b.x()) * (a.y() + b.y()));
+      n += Eigen::Vector3d((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()),
+                           (a.x() - b.x()) * (a.y() + b.y()));
       mean += a;
       ++count;
       e = e->getNextEdgeOfFace();

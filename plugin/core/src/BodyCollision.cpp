@@ -13,13 +13,19 @@ namespace {
 // Radius of a sphere about the collider's origin that holds the whole shape (infinite for planes).
 float boundingRadius(const Collider& c) {
   switch (c.shape) {
-    case ColliderShape::Sphere: return c.radius;
-    case ColliderShape::Capsule: return c.radius + c.halfHeight;
-    case ColliderShape::Cylinder: return std::hypot(c.radius, c.halfHeight);
-    case ColliderShape::Box: return c.halfExtents.norm();
-    case ColliderShape::ConvexHull: return c.hull->radius;
+    case ColliderShape::Sphere:
+      return c.radius;
+    case ColliderShape::Capsule:
+      return c.radius + c.halfHeight;
+    case ColliderShape::Cylinder:
+      return std::hypot(c.radius, c.halfHeight);
+    case ColliderShape::Box:
+      return c.halfExtents.norm();
+    case ColliderShape::ConvexHull:
+      return c.hull->radius;
     case ColliderShape::Plane:
-    case ColliderShape::TriangleMesh: return std::numeric_limits<float>::infinity();
+    case ColliderShape::TriangleMesh:
+      return std::numeric_limits<float>::infinity();
   }
   return std::numeric_limits<float>::infinity();
 }
@@ -27,7 +33,7 @@ float boundingRadius(const Collider& c) {
 /// What one collider's pass needs besides the particles.
 struct PassArrays {
   std::vector<Cape::Contact>* contacts;
-  std::vector<Eigen::Vector4f>* planes;    ///< per contact: a triangle mesh's contact plane (n, offset)
+  std::vector<Eigen::Vector4f>* planes;  ///< per contact: a triangle mesh's contact plane (n, offset)
   std::uint32_t collider;
   float maxTravel;                         ///< the largest distance any particle moved in this substep, m
   Eigen::ArrayXf* distance2;               ///< scratch, one per particle
@@ -44,10 +50,15 @@ struct Sweep {
   float turn;    ///< rotation angle from A to B, rad
   float margin;  ///< the cape's thickness plus the collider's, m
   Sweep(const Collider& c, float s0, float s1, float margin_)
-      : A(Pose::interpolate(c.previous, c.current, s0)), B(Pose::interpolate(c.previous, c.current, s1)),
-        invRA(A.rotation.conjugate().toRotationMatrix()), invRB(B.rotation.conjugate().toRotationMatrix()),
-        RB(B.rotation.toRotationMatrix()), bound(boundingRadius(c)), shift((B.position - A.position).norm()),
-        turn(A.rotation.angularDistance(B.rotation)), margin(margin_) {}
+      : A(Pose::interpolate(c.previous, c.current, s0)),
+        B(Pose::interpolate(c.previous, c.current, s1)),
+        invRA(A.rotation.conjugate().toRotationMatrix()),
+        invRB(B.rotation.conjugate().toRotationMatrix()),
+        RB(B.rotation.toRotationMatrix()),
+        bound(boundingRadius(c)),
+        shift((B.position - A.position).norm()),
+        turn(A.rotation.angularDistance(B.rotation)),
+        margin(margin_) {}
 };
 
 /// Broad phase, vectorised over all particles: the free particles that could reach the collider (a lower
@@ -99,7 +110,8 @@ void gatherCandidates(const Collider& c, const CollisionArrays& p, const PassArr
           lower = std::max(std::max(std::abs(b0) - hx, std::abs(b1) - hy), std::abs(b2) - hz);
         } else if constexpr (S == ColliderShape::Capsule) {
           const float beyond = std::abs(b0) - halfHeight;  // past the end of the segment, along the axis
-          const float along = 0.5f * (beyond + std::abs(beyond));  // max(beyond, 0), exactly, without a branch
+          const float along =
+              0.5f * (beyond + std::abs(beyond));  // max(beyond, 0), exactly, without a branch
           lower = std::sqrt(along * along + b1 * b1 + b2 * b2) - radius;
         } else {
           lower = std::max(std::sqrt(b1 * b1 + b2 * b2) - radius, std::abs(b0) - halfHeight);
@@ -122,8 +134,8 @@ void gatherCandidates(const Collider& c, const CollisionArrays& p, const PassArr
 /// s0) to b (its prediction, in the frame at s1). Returns whether it touched; then `bn` is where it ends,
 /// outside the skin, and `normal` the contact normal.
 template <ColliderShape S>
-bool resolveSweep(const Collider& c, float margin, const Vec3& a, const Vec3& b, const SurfaceDistance& sb, Vec3& bn,
-                  Vec3& normal) {
+bool resolveSweep(const Collider& c, float margin, const Vec3& a, const Vec3& b, const SurfaceDistance& sb,
+                  Vec3& bn, Vec3& normal) {
   const SurfaceDistance sa = shapeDistance<S>(c, a);
   bn = b;
   normal = sb.normal;
@@ -187,8 +199,9 @@ inline void applyFriction(float mu, const Vec3& a, const Vec3& b, const Vec3& no
 /// particle moves from its start to its prediction: relative motion, so a fast collider and a fast particle
 /// are the same problem.
 template <ColliderShape S>
-__attribute__((flatten)) void collideWith(const Collider& c, const CollisionArrays& p, const PassArrays& q, float s0,
-                                          float s1, float margin, float mu, float invH, bool explicitMode) {
+__attribute__((flatten)) void collideWith(const Collider& c, const CollisionArrays& p, const PassArrays& q,
+                                          float s0, float s1, float margin, float mu, float invH,
+                                          bool explicitMode) {
   const Sweep w(c, s0, s1, margin);
   gatherCandidates<S>(c, p, q, w);
   for (const std::uint32_t i : *q.candidates) {
@@ -231,8 +244,8 @@ __attribute__((flatten)) void collideWith(const Collider& c, const CollisionArra
 /// One particle of a triangle mesh's pass, in the mesh's frame: at b (its prediction), against its candidate
 /// triangles, each on the side of its plane the particle was on at the start of the step. Returns whether
 /// it touched; then bn is where it ends and `plane` the last contact plane (n, offset).
-inline bool resolveMesh(const TriangleSoup& soup, const MeshCandidate* begin, const MeshCandidate* end, float margin,
-                        const Vec3& b, Vec3& bn, Vec3& normal, Eigen::Vector4f& plane) {
+inline bool resolveMesh(const TriangleSoup& soup, const MeshCandidate* begin, const MeshCandidate* end,
+                        float margin, const Vec3& b, Vec3& bn, Vec3& normal, Eigen::Vector4f& plane) {
   // Over a face by barycentric weights of the projection with this tolerance: a point over the edge two
   // triangles share is over both, never beside both.
   constexpr float kOverFace = 1e-4f;
@@ -279,7 +292,8 @@ inline bool resolveMesh(const TriangleSoup& soup, const MeshCandidate* begin, co
 /// Pushes the contact's particle back out of its collider (pose at the substep's end) if the constraint
 /// solve moved it into the skin.
 template <ColliderShape S>
-void reprojectOne(const Collider& c, const Pose& B, float margin, float* px, float* py, float* pz, std::uint32_t i) {
+void reprojectOne(const Collider& c, const Pose& B, float margin, float* px, float* py, float* pz,
+                  std::uint32_t i) {
   const Vec3 x(px[i], py[i], pz[i]);
   const Vec3 b = B.applyInverse(x);
   const SurfaceDistance s = shapeDistance<S>(c, b);
@@ -291,8 +305,8 @@ void reprojectOne(const Collider& c, const Pose& B, float margin, float* px, flo
 }
 
 /// A triangle mesh's contact: out of its contact plane (n, offset in the mesh's frame at B) to the margin.
-inline void reprojectPlane(const Eigen::Vector4f& plane, const Pose& B, float margin, float* px, float* py, float* pz,
-                           std::uint32_t i) {
+inline void reprojectPlane(const Eigen::Vector4f& plane, const Pose& B, float margin, float* px, float* py,
+                           float* pz, std::uint32_t i) {
   const Vec3 b = B.applyInverse(Vec3(px[i], py[i], pz[i]));
   const Vec3 n = plane.head<3>();
   const float d = n.dot(b) - plane[3];
@@ -313,8 +327,8 @@ BodyCollision::BodyCollision(std::size_t particles) {
   candidates_.reserve(particles);
 }
 
-void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settings, float h, float s0, float s1,
-                            ColliderSpan colliders, bool explicitMode) {
+void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settings, float h, float s0,
+                            float s1, ColliderSpan colliders, bool explicitMode) {
   PassArrays q{&contacts_, &contactPlanes_, 0, 0.0f, &distance2_, &candidates_};
   float maxTravel2 = 0.0f;
   for (Eigen::Index i = 0; i < p.n; ++i) {
@@ -333,19 +347,33 @@ void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settin
     const float margin = settings.collisionThickness + c.thickness;
     const float mu = c.friction >= 0.0f ? c.friction : settings.friction;
     switch (c.shape) {
-      case ColliderShape::Sphere: collideWith<ColliderShape::Sphere>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
-      case ColliderShape::Capsule: collideWith<ColliderShape::Capsule>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
-      case ColliderShape::Cylinder: collideWith<ColliderShape::Cylinder>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
-      case ColliderShape::Box: collideWith<ColliderShape::Box>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
-      case ColliderShape::Plane: collideWith<ColliderShape::Plane>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
-      case ColliderShape::ConvexHull: collideWith<ColliderShape::ConvexHull>(c, p, q, s0, s1, margin, mu, invH, explicitMode); break;
-      case ColliderShape::TriangleMesh: collideMesh(c, p, q.collider, s0, s1, margin, mu, invH, explicitMode); break;
+      case ColliderShape::Sphere:
+        collideWith<ColliderShape::Sphere>(c, p, q, s0, s1, margin, mu, invH, explicitMode);
+        break;
+      case ColliderShape::Capsule:
+        collideWith<ColliderShape::Capsule>(c, p, q, s0, s1, margin, mu, invH, explicitMode);
+        break;
+      case ColliderShape::Cylinder:
+        collideWith<ColliderShape::Cylinder>(c, p, q, s0, s1, margin, mu, invH, explicitMode);
+        break;
+      case ColliderShape::Box:
+        collideWith<ColliderShape::Box>(c, p, q, s0, s1, margin, mu, invH, explicitMode);
+        break;
+      case ColliderShape::Plane:
+        collideWith<ColliderShape::Plane>(c, p, q, s0, s1, margin, mu, invH, explicitMode);
+        break;
+      case ColliderShape::ConvexHull:
+        collideWith<ColliderShape::ConvexHull>(c, p, q, s0, s1, margin, mu, invH, explicitMode);
+        break;
+      case ColliderShape::TriangleMesh:
+        collideMesh(c, p, q.collider, s0, s1, margin, mu, invH, explicitMode);
+        break;
     }
   }
 }
 
-void BodyCollision::beginStep(const CapeState& state, ColliderSpan colliders, const CapeSettings& settings, float dt,
-                              float slack) {
+void BodyCollision::beginStep(const CapeState& state, ColliderSpan colliders, const CapeSettings& settings,
+                              float dt, float slack) {
   // Each free particle's candidate triangles of each mesh: those whose box overlaps the box of the
   // particle's predicted path over the step in the mesh's frame (from where it is, at the mesh's start pose,
   // to x + v dt + g dt^2 / 2 at its end pose), grown by the margin, the slack and half the path (the
@@ -364,7 +392,8 @@ void BodyCollision::beginStep(const CapeState& state, ColliderSpan colliders, co
       meshStart_.push_back(static_cast<std::uint32_t>(meshCandidates_.size()));
       if (state.inverseMasses[i] == 0.0f) continue;
       const Vec3 x = state.positions.row(i).transpose();
-      const Vec3 predicted = x + dt * Vec3(state.velocities.row(i).transpose()) + (0.5f * dt * dt) * settings.gravity;
+      const Vec3 predicted =
+          x + dt * Vec3(state.velocities.row(i).transpose()) + (0.5f * dt * dt) * settings.gravity;
       const Vec3 p0 = c.previous.applyInverse(x), p1 = c.current.applyInverse(predicted);
       if (!p0.allFinite() || !p1.allFinite()) continue;
       const float grow = margin + slack + 0.5f * (p1 - p0).norm();
@@ -374,21 +403,24 @@ void BodyCollision::beginStep(const CapeState& state, ColliderSpan colliders, co
   }
 }
 
-void BodyCollision::gatherTriangles(const TriangleSoup& soup, const Vec3& p0, const Vec3& lo, const Vec3& hi) {
+void BodyCollision::gatherTriangles(const TriangleSoup& soup, const Vec3& p0, const Vec3& lo,
+                                    const Vec3& hi) {
   for (std::size_t t = 0; t < soup.size(); ++t) {
     const Vec3 &a = soup.corners[3 * t], &b = soup.corners[3 * t + 1], &c = soup.corners[3 * t + 2];
-    if ((a.cwiseMin(b).cwiseMin(c).array() > hi.array()).any() || (a.cwiseMax(b).cwiseMax(c).array() < lo.array()).any())
+    if ((a.cwiseMin(b).cwiseMin(c).array() > hi.array()).any() ||
+        (a.cwiseMax(b).cwiseMax(c).array() < lo.array()).any())
       continue;
     const float side = (b - a).cross(c - a).dot(p0 - a) >= 0.0f ? 1.0f : -1.0f;
     meshCandidates_.push_back({static_cast<std::uint32_t>(t), side});
   }
 }
 
-void BodyCollision::collideMesh(const Collider& c, const CollisionArrays& p, std::uint32_t ci, float s0, float s1,
-                                float margin, float mu, float invH, bool explicitMode) {
+void BodyCollision::collideMesh(const Collider& c, const CollisionArrays& p, std::uint32_t ci, float s0,
+                                float s1, float margin, float mu, float invH, bool explicitMode) {
   if (ci >= meshSlot_.size() || meshSlot_[ci] < 0) return;  // not seen by beginStep: no candidates
   const Sweep w(c, s0, s1, margin);
-  const std::uint32_t* start = &meshStart_[static_cast<std::size_t>(meshSlot_[ci]) * static_cast<std::size_t>(p.n + 1)];
+  const std::uint32_t* start =
+      &meshStart_[static_cast<std::size_t>(meshSlot_[ci]) * static_cast<std::size_t>(p.n + 1)];
   for (Eigen::Index i = 0; i < p.n; ++i) {
     if (start[i] == start[i + 1] || p.w[i] == 0.0f) continue;
     const Vec3 x(p.px[i], p.py[i], p.pz[i]);
@@ -396,8 +428,8 @@ void BodyCollision::collideMesh(const Collider& c, const CollisionArrays& p, std
     const Vec3 b = w.invRB * (x - w.B.position);
     Vec3 bn, normal;
     Eigen::Vector4f plane;
-    if (!resolveMesh(*c.triangles, &meshCandidates_[start[i]], meshCandidates_.data() + start[i + 1], margin, b, bn,
-                     normal, plane))
+    if (!resolveMesh(*c.triangles, &meshCandidates_[start[i]], meshCandidates_.data() + start[i + 1], margin,
+                     b, bn, normal, plane))
       continue;
     applyFriction(mu, a, b, normal, bn);
     const Vec3 xn = w.RB * bn + w.B.position;
@@ -414,20 +446,35 @@ void BodyCollision::collideMesh(const Collider& c, const CollisionArrays& p, std
   }
 }
 
-void BodyCollision::reproject(const CollisionArrays& p, const CapeSettings& settings, ColliderSpan colliders) {
+void BodyCollision::reproject(const CollisionArrays& p, const CapeSettings& settings,
+                              ColliderSpan colliders) {
   for (std::size_t j = 0; j < contacts_.size(); ++j) {
     const Cape::Contact& k = contacts_[j];
     const Collider& c = colliders.data[k.collider];
     const Pose& B = colliderEnd_[k.collider];
     const float margin = settings.collisionThickness + c.thickness;
     switch (c.shape) {
-      case ColliderShape::Sphere: reprojectOne<ColliderShape::Sphere>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
-      case ColliderShape::Capsule: reprojectOne<ColliderShape::Capsule>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
-      case ColliderShape::Cylinder: reprojectOne<ColliderShape::Cylinder>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
-      case ColliderShape::Box: reprojectOne<ColliderShape::Box>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
-      case ColliderShape::Plane: reprojectOne<ColliderShape::Plane>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
-      case ColliderShape::ConvexHull: reprojectOne<ColliderShape::ConvexHull>(c, B, margin, p.px, p.py, p.pz, k.particle); break;
-      case ColliderShape::TriangleMesh: reprojectPlane(contactPlanes_[j], B, margin, p.px, p.py, p.pz, k.particle); break;
+      case ColliderShape::Sphere:
+        reprojectOne<ColliderShape::Sphere>(c, B, margin, p.px, p.py, p.pz, k.particle);
+        break;
+      case ColliderShape::Capsule:
+        reprojectOne<ColliderShape::Capsule>(c, B, margin, p.px, p.py, p.pz, k.particle);
+        break;
+      case ColliderShape::Cylinder:
+        reprojectOne<ColliderShape::Cylinder>(c, B, margin, p.px, p.py, p.pz, k.particle);
+        break;
+      case ColliderShape::Box:
+        reprojectOne<ColliderShape::Box>(c, B, margin, p.px, p.py, p.pz, k.particle);
+        break;
+      case ColliderShape::Plane:
+        reprojectOne<ColliderShape::Plane>(c, B, margin, p.px, p.py, p.pz, k.particle);
+        break;
+      case ColliderShape::ConvexHull:
+        reprojectOne<ColliderShape::ConvexHull>(c, B, margin, p.px, p.py, p.pz, k.particle);
+        break;
+      case ColliderShape::TriangleMesh:
+        reprojectPlane(contactPlanes_[j], B, margin, p.px, p.py, p.pz, k.particle);
+        break;
     }
   }
 }

@@ -18,8 +18,8 @@ struct CollisionArrays {
   const float* sx;  ///< positions at the start of the substep
   const float* sy;
   const float* sz;
-  const float* w;   ///< inverse masses (0: pinned, never moved)
-  float* vx;        ///< velocities, corrected only in the explicit mode
+  const float* w;  ///< inverse masses (0: pinned, never moved)
+  float* vx;       ///< velocities, corrected only in the explicit mode
   float* vy;
   float* vz;
   Eigen::Index n;
@@ -39,7 +39,8 @@ class BodyCollision {
   /// Once per step, before the substeps: every free particle's candidate triangles of every triangle-mesh
   /// collider (the other shapes need nothing). `slack`, m, covers how far the solver's corrections may carry
   /// a particle beyond its predicted path.
-  void beginStep(const CapeState& state, ColliderSpan colliders, const CapeSettings& settings, float dt, float slack);
+  void beginStep(const CapeState& state, ColliderSpan colliders, const CapeSettings& settings, float dt,
+                 float slack);
 
   /// The substep [s0, s1] of the step (fractions of it; h seconds long): every free particle of `p` against
   /// every valid collider's sweep. An invalid collider (NaN pose, bad size) is skipped. In the explicit
@@ -53,14 +54,14 @@ class BodyCollision {
   const std::vector<Cape::Contact>& contacts() const { return contacts_; }
 
  private:
-  std::vector<Pose> colliderEnd_;          ///< Collider poses at the end of the substep.
-  std::vector<Cape::Contact> contacts_;    ///< Contacts of the substep's collision pass.
-  Eigen::ArrayXf distance2_;               ///< Broad-phase scratch, one per particle.
-  std::vector<std::uint32_t> candidates_;  ///< Broad-phase scratch.
+  std::vector<Pose> colliderEnd_;               ///< Collider poses at the end of the substep.
+  std::vector<Cape::Contact> contacts_;         ///< Contacts of the substep's collision pass.
+  Eigen::ArrayXf distance2_;                    ///< Broad-phase scratch, one per particle.
+  std::vector<std::uint32_t> candidates_;       ///< Broad-phase scratch.
   std::vector<Eigen::Vector4f> contactPlanes_;  ///< Per contact: a mesh's contact plane (n, offset), else 0.
   // Triangle meshes: per mesh (in collider order), particle i's candidates are
   // meshCandidates_[meshStart_[slot * (n + 1) + i] .. meshStart_[slot * (n + 1) + i + 1]).
-  std::vector<int> meshSlot_;              ///< Per collider of the step: its mesh slot, or -1.
+  std::vector<int> meshSlot_;  ///< Per collider of the step: its mesh slot, or -1.
   std::vector<std::uint32_t> meshStart_;
   std::vector<MeshCandidate> meshCandidates_;
 

@@ -18,9 +18,12 @@ constexpr int kContactPasses = 3;  // extra push-out passes over the substep's c
 
 float stiffnessOf(const CapeSettings& s, int family) {
   switch (static_cast<SpringFamily>(family)) {
-    case SpringFamily::Structural: return s.structuralStiffness;
-    case SpringFamily::Shear: return s.shearStiffness;
-    case SpringFamily::Bend: return s.bendStiffness;
+    case SpringFamily::Structural:
+      return s.structuralStiffness;
+    case SpringFamily::Shear:
+      return s.shearStiffness;
+    case SpringFamily::Bend:
+      return s.bendStiffness;
   }
   return 0.0f;
 }
@@ -74,7 +77,8 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   state_.positions.resize(n, 3);
   const Eigen::Matrix3f r = placement.rotation.toRotationMatrix();
   for (Eigen::Index i = 0; i < n; ++i)
-    state_.positions.row(i) = (r * fabric_->restPositions().row(i).transpose() + placement.position).transpose();
+    state_.positions.row(i) =
+        (r * fabric_->restPositions().row(i).transpose() + placement.position).transpose();
   state_.velocities = Points::Zero(n, 3);
   state_.inverseMasses = fabric_->masses().cwiseInverse();
   state_.pins.reserve(static_cast<std::size_t>(n));
@@ -86,14 +90,18 @@ Cape::~Cape() = default;
 Cape::Cape(Cape&&) noexcept = default;
 Cape& Cape::operator=(Cape&&) noexcept = default;
 
-float Cape::selfCollisionThickness() const { return work_ ? work_->self.thickness(settings_) : 0.0f; }
+float Cape::selfCollisionThickness() const {
+  return work_ ? work_->self.thickness(settings_) : 0.0f;
+}
 
 const std::vector<Cape::SelfContact>& Cape::selfContacts() const {
   static const std::vector<SelfContact> none;
   return work_ ? work_->self.contacts() : none;
 }
 
-std::uint64_t Cape::selfContactSearches() const { return work_ ? work_->self.searches() : 0; }
+std::uint64_t Cape::selfContactSearches() const {
+  return work_ ? work_->self.searches() : 0;
+}
 
 Status Cape::setSettings(const CapeSettings& settings) {
   Status s = settings.validate();
@@ -116,7 +124,8 @@ Status Cape::setSettings(const CapeSettings& settings) {
 }
 
 std::size_t Cape::pin(std::uint32_t particle, const Vec3& target) {
-  if (!ok() || particle >= fabric_->particleCount() || !target.allFinite()) return static_cast<std::size_t>(-1);
+  if (!ok() || particle >= fabric_->particleCount() || !target.allFinite())
+    return static_cast<std::size_t>(-1);
   for (std::size_t k = 0; k < state_.pins.size(); ++k) {
     if (state_.pins[k].particle == particle) {
       state_.pins[k].previousTarget = state_.pins[k].target = target;
@@ -130,7 +139,8 @@ std::size_t Cape::pin(std::uint32_t particle, const Vec3& target) {
 
 void Cape::unpin(std::uint32_t particle) {
   if (!ok() || particle >= fabric_->particleCount()) return;
-  auto it = std::find_if(state_.pins.begin(), state_.pins.end(), [&](const Pin& p) { return p.particle == particle; });
+  auto it = std::find_if(state_.pins.begin(), state_.pins.end(),
+                         [&](const Pin& p) { return p.particle == particle; });
   if (it == state_.pins.end()) return;
   state_.pins.erase(it);
   state_.inverseMasses[particle] = 1.0f / fabric_->masses()[particle];
@@ -209,7 +219,8 @@ void Cape::beginStep(const StepPlan& plan, float dt, ColliderSpan colliders) {
   // The air's velocity at each particle, once per step at its middle: gusts change over tenths of a second,
   // far slower than a frame.
   if (settings_.wind.model != WindSettings::Model::None)
-    windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt), work_->airVelocity);
+    windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt),
+                   work_->airVelocity);
   // Triangle meshes: each particle's candidate triangles for the whole step, found once. The slack, a
   // quarter of the spacing, is the self-collision search's for the same reason.
   work_->body.beginStep(state_, colliders, settings_, dt, 0.25f * fabric_->meanSpacing());
@@ -275,10 +286,14 @@ void Cape::accumulateExternalAcceleration() {
     // Per triangle, from the air's velocity relative to the triangle (averages of its corners); a third of
     // the force goes to each corner. Flat arrays: this loop runs once per substep over every triangle.
     const std::vector<std::uint32_t>& tri = fabric_->triangles();
-    const float *px = state_.positions.col(0).data(), *py = state_.positions.col(1).data(), *pz = state_.positions.col(2).data();
-    const float *vx = state_.velocities.col(0).data(), *vy = state_.velocities.col(1).data(), *vz = state_.velocities.col(2).data();
-    const float *ux = work_->airVelocity.col(0).data(), *uy = work_->airVelocity.col(1).data(), *uz = work_->airVelocity.col(2).data();
-    float *ax = work_->acceleration.col(0).data(), *ay = work_->acceleration.col(1).data(), *az = work_->acceleration.col(2).data();
+    const float *px = state_.positions.col(0).data(), *py = state_.positions.col(1).data(),
+                *pz = state_.positions.col(2).data();
+    const float *vx = state_.velocities.col(0).data(), *vy = state_.velocities.col(1).data(),
+                *vz = state_.velocities.col(2).data();
+    const float *ux = work_->airVelocity.col(0).data(), *uy = work_->airVelocity.col(1).data(),
+                *uz = work_->airVelocity.col(2).data();
+    float *ax = work_->acceleration.col(0).data(), *ay = work_->acceleration.col(1).data(),
+          *az = work_->acceleration.col(2).data();
     const float* w = state_.inverseMasses.data();
     const float rho = wind.airDensity, cd = wind.dragCoefficient, cl = wind.liftCoefficient;
     for (std::size_t t = 0; t + 2 < tri.size(); t += 3) {
@@ -330,11 +345,16 @@ void Cape::solveConstraints(float h) {
 }
 
 void Cape::collideBodies(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode) {
-  const detail::CollisionArrays p{state_.positions.col(0).data(),  state_.positions.col(1).data(),
-                                  state_.positions.col(2).data(),  work_->startPositions.col(0).data(),
-                                  work_->startPositions.col(1).data(), work_->startPositions.col(2).data(),
-                                  state_.inverseMasses.data(),     state_.velocities.col(0).data(),
-                                  state_.velocities.col(1).data(), state_.velocities.col(2).data(),
+  const detail::CollisionArrays p{state_.positions.col(0).data(),
+                                  state_.positions.col(1).data(),
+                                  state_.positions.col(2).data(),
+                                  work_->startPositions.col(0).data(),
+                                  work_->startPositions.col(1).data(),
+                                  work_->startPositions.col(2).data(),
+                                  state_.inverseMasses.data(),
+                                  state_.velocities.col(0).data(),
+                                  state_.velocities.col(1).data(),
+                                  state_.velocities.col(2).data(),
                                   state_.positions.rows()};
   work_->body.collide(p, settings_, h, s0, s1, colliders, explicitMode);
   // A particle wedged where two colliders meet (a shoulder sphere poking out of the torso box) is pushed out
@@ -357,8 +377,9 @@ void Cape::updateVelocities(float h) {
   const float scale = 1.0f / (h * (1.0f + settings_.damping * h));
   const Eigen::VectorXf& free = work_->freeMask;
   for (int c = 0; c < 3; ++c) {
-    state_.velocities.col(c) = free.cwiseProduct(state_.positions.col(c) - work_->startPositions.col(c)) * scale +
-                               (1.0f - free.array()).matrix().cwiseProduct(state_.velocities.col(c));
+    state_.velocities.col(c) =
+        free.cwiseProduct(state_.positions.col(c) - work_->startPositions.col(c)) * scale +
+        (1.0f - free.array()).matrix().cwiseProduct(state_.velocities.col(c));
   }
 }
 
@@ -407,8 +428,8 @@ void Cape::solveSprings(float h) {
 
 void Cape::solveTethers() {
   // Long-range attachments (Fabric.h's TetherSet); the kernel is in SpringSolver.h.
-  detail::solveTethers(state_.positions.col(0).data(), state_.positions.col(1).data(), state_.positions.col(2).data(),
-                       state_.inverseMasses.data(), fabric_->tethers());
+  detail::solveTethers(state_.positions.col(0).data(), state_.positions.col(1).data(),
+                       state_.positions.col(2).data(), state_.inverseMasses.data(), fabric_->tethers());
 }
 
 void Cape::substepExplicit(float h, float s0, float s1, ColliderSpan colliders) {

@@ -7,8 +7,10 @@ namespace cape {
 
 const char* toString(Integrator integrator) {
   switch (integrator) {
-    case Integrator::Xpbd: return "xpbd";
-    case Integrator::ExplicitSpring: return "explicit";
+    case Integrator::Xpbd:
+      return "xpbd";
+    case Integrator::ExplicitSpring:
+      return "explicit";
   }
   return "?";
 }
@@ -44,23 +46,29 @@ Status CapeSettings::validate() const {
   if (integrator == Integrator::ExplicitSpring &&
       (std::isinf(structuralStiffness) || std::isinf(shearStiffness) || std::isinf(bendStiffness)))
     return Status::error("CapeSettings: the explicit integrator needs finite stiffness");
-  if (!finiteNonNegative(damping)) return Status::error("CapeSettings: damping must be finite and >= 0 (1/s)");
+  if (!finiteNonNegative(damping))
+    return Status::error("CapeSettings: damping must be finite and >= 0 (1/s)");
   if (!finiteNonNegative(collisionThickness))
     return Status::error("CapeSettings: collisionThickness must be finite and >= 0 (m)");
   if (!finiteNonNegative(friction)) return Status::error("CapeSettings: friction must be finite and >= 0");
   if (!(std::isfinite(selfCollisionThickness) && selfCollisionThickness >= 0.0f))
     return Status::error("CapeSettings: selfCollisionThickness must be finite and >= 0 (m; 0 = automatic)");
   if (substeps < 1 || substeps > 1000) return Status::error("CapeSettings: substeps must be in 1..1000");
-  if (!(std::isfinite(strainLimit) && strainLimit >= 0.0f)) return Status::error("CapeSettings: strainLimit must be finite and >= 0");
-  if (maxRefinement < 1 || maxRefinement > 64) return Status::error("CapeSettings: maxRefinement must be in 1..64");
-  if (iterations < 1 || iterations > 1000) return Status::error("CapeSettings: iterations must be in 1..1000");
+  if (!(std::isfinite(strainLimit) && strainLimit >= 0.0f))
+    return Status::error("CapeSettings: strainLimit must be finite and >= 0");
+  if (maxRefinement < 1 || maxRefinement > 64)
+    return Status::error("CapeSettings: maxRefinement must be in 1..64");
+  if (iterations < 1 || iterations > 1000)
+    return Status::error("CapeSettings: iterations must be in 1..1000");
   if (!gravity.allFinite()) return Status::error("CapeSettings: gravity must be finite");
-  if (!(std::isfinite(timeStep) && timeStep > 0.0f)) return Status::error("CapeSettings: timeStep must be > 0 s");
+  if (!(std::isfinite(timeStep) && timeStep > 0.0f))
+    return Status::error("CapeSettings: timeStep must be > 0 s");
   if (wind.model != WindSettings::Model::None) {
     if (!wind.direction.allFinite() || !(wind.direction.norm() > 0.0f))
       return Status::error("CapeSettings: wind direction must be a finite nonzero vector");
     if (!finiteNonNegative(wind.speed) || !finiteNonNegative(wind.gustAmplitude) ||
-        !finiteNonNegative(wind.gustFrequency) || !(std::isfinite(wind.turbulenceScale) && wind.turbulenceScale > 0.0f) ||
+        !finiteNonNegative(wind.gustFrequency) ||
+        !(std::isfinite(wind.turbulenceScale) && wind.turbulenceScale > 0.0f) ||
         !finiteNonNegative(wind.airDensity) || !finiteNonNegative(wind.dragCoefficient) ||
         !std::isfinite(wind.liftCoefficient))
       return Status::error("CapeSettings: wind parameters must be finite and >= 0 (turbulence scale > 0)");

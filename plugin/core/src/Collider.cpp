@@ -9,18 +9,26 @@ namespace cape {
 
 const char* toString(ColliderShape shape) {
   switch (shape) {
-    case ColliderShape::Sphere: return "sphere";
-    case ColliderShape::Capsule: return "capsule";
-    case ColliderShape::Cylinder: return "cylinder";
-    case ColliderShape::Box: return "box";
-    case ColliderShape::Plane: return "plane";
-    case ColliderShape::ConvexHull: return "convex_hull";
-    case ColliderShape::TriangleMesh: return "triangle_mesh";
+    case ColliderShape::Sphere:
+      return "sphere";
+    case ColliderShape::Capsule:
+      return "capsule";
+    case ColliderShape::Cylinder:
+      return "cylinder";
+    case ColliderShape::Box:
+      return "box";
+    case ColliderShape::Plane:
+      return "plane";
+    case ColliderShape::ConvexHull:
+      return "convex_hull";
+    case ColliderShape::TriangleMesh:
+      return "triangle_mesh";
   }
   return "?";
 }
 
-std::shared_ptr<const ConvexHull> ConvexHull::make(std::vector<Vec3> vertices, std::vector<Eigen::Vector4f> planes) {
+std::shared_ptr<const ConvexHull> ConvexHull::make(std::vector<Vec3> vertices,
+                                                   std::vector<Eigen::Vector4f> planes) {
   auto hull = std::make_shared<ConvexHull>();
   hull->vertices = std::move(vertices);
   hull->planes = std::move(planes);
@@ -29,12 +37,14 @@ std::shared_ptr<const ConvexHull> ConvexHull::make(std::vector<Vec3> vertices, s
 }
 
 Status ConvexHull::validate() const {
-  if (vertices.size() < 4 || planes.size() < 4) return Status::error("needs at least 4 vertices and 4 planes");
+  if (vertices.size() < 4 || planes.size() < 4)
+    return Status::error("needs at least 4 vertices and 4 planes");
   for (const Vec3& v : vertices)
     if (!v.allFinite()) return Status::error("a vertex is not finite");
   for (const Eigen::Vector4f& p : planes) {
     if (!p.allFinite()) return Status::error("a plane is not finite");
-    if (std::abs(p.head<3>().norm() - 1.0f) > 1e-3f) return Status::error("a plane normal is not a unit vector");
+    if (std::abs(p.head<3>().norm() - 1.0f) > 1e-3f)
+      return Status::error("a plane normal is not a unit vector");
     for (const Vec3& v : vertices)
       if (p.head<3>().dot(v) - p[3] > 1e-4f) return Status::error("a vertex lies outside a face plane");
   }
@@ -100,8 +110,8 @@ Collider Collider::plane(const Vec3& normal, float constant) {
 
 Status Collider::validate() const {
   auto bad = [this](const std::string& what) {
-    return Status::error(std::string(toString(shape)) + " collider" + (name.empty() ? "" : " '" + name + "'") +
-                         ": " + what);
+    return Status::error(std::string(toString(shape)) + " collider" +
+                         (name.empty() ? "" : " '" + name + "'") + ": " + what);
   };
   auto positive = [](float v) { return std::isfinite(v) && v > 0.0f; };
   if (!previous.isFinite() || !current.isFinite()) return bad("pose is not finite (or rotation not unit)");
@@ -116,7 +126,8 @@ Status Collider::validate() const {
       if (!positive(radius)) return bad("radius must be finite and > 0");
       if (!(std::isfinite(halfHeight) && halfHeight >= 0.0f) ||
           (shape == ColliderShape::Cylinder && !(halfHeight > 0.0f)))
-        return bad("half height must be finite and " + std::string(shape == ColliderShape::Cylinder ? "> 0" : ">= 0"));
+        return bad("half height must be finite and " +
+                   std::string(shape == ColliderShape::Cylinder ? "> 0" : ">= 0"));
       if (axis < 0 || axis > 2) return bad("axis must be 0 (X), 1 (Y) or 2 (Z)");
       break;
     case ColliderShape::Box:
@@ -124,7 +135,8 @@ Status Collider::validate() const {
         return bad("half extents must be finite and > 0");
       break;
     case ColliderShape::Plane:
-      if (!normal.allFinite() || std::abs(normal.norm() - 1.0f) > 1e-3f) return bad("normal must be a unit vector");
+      if (!normal.allFinite() || std::abs(normal.norm() - 1.0f) > 1e-3f)
+        return bad("normal must be a unit vector");
       if (!std::isfinite(constant)) return bad("constant must be finite");
       break;
     case ColliderShape::ConvexHull:
@@ -140,13 +152,20 @@ Status Collider::validate() const {
 SurfaceDistance localSignedDistance(const Collider& c, const Vec3& p) {
   using detail::shapeDistance;
   switch (c.shape) {
-    case ColliderShape::Sphere: return shapeDistance<ColliderShape::Sphere>(c, p);
-    case ColliderShape::Capsule: return shapeDistance<ColliderShape::Capsule>(c, p);
-    case ColliderShape::Cylinder: return shapeDistance<ColliderShape::Cylinder>(c, p);
-    case ColliderShape::Box: return shapeDistance<ColliderShape::Box>(c, p);
-    case ColliderShape::Plane: return shapeDistance<ColliderShape::Plane>(c, p);
-    case ColliderShape::ConvexHull: return shapeDistance<ColliderShape::ConvexHull>(c, p);
-    case ColliderShape::TriangleMesh: return detail::meshDistance(*c.triangles, p);
+    case ColliderShape::Sphere:
+      return shapeDistance<ColliderShape::Sphere>(c, p);
+    case ColliderShape::Capsule:
+      return shapeDistance<ColliderShape::Capsule>(c, p);
+    case ColliderShape::Cylinder:
+      return shapeDistance<ColliderShape::Cylinder>(c, p);
+    case ColliderShape::Box:
+      return shapeDistance<ColliderShape::Box>(c, p);
+    case ColliderShape::Plane:
+      return shapeDistance<ColliderShape::Plane>(c, p);
+    case ColliderShape::ConvexHull:
+      return shapeDistance<ColliderShape::ConvexHull>(c, p);
+    case ColliderShape::TriangleMesh:
+      return detail::meshDistance(*c.triangles, p);
   }
   return {0.0f, Vec3::UnitY()};
 }

@@ -10,9 +10,12 @@ namespace cape {
 
 const char* toString(SpringFamily family) {
   switch (family) {
-    case SpringFamily::Structural: return "structural";
-    case SpringFamily::Shear: return "shear";
-    case SpringFamily::Bend: return "bend";
+    case SpringFamily::Structural:
+      return "structural";
+    case SpringFamily::Shear:
+      return "shear";
+    case SpringFamily::Bend:
+      return "bend";
   }
   return "?";
 }
@@ -30,7 +33,9 @@ void addSpring(SpringSet& set, std::uint32_t a, std::uint32_t b) {
   set.second.push_back(b);
 }
 
-bool finitePositive(float v) { return std::isfinite(v) && v > 0.0f; }
+bool finitePositive(float v) {
+  return std::isfinite(v) && v > 0.0f;
+}
 
 // Greedy graph colouring of a family's springs (first fit, in build order), then a stable sort by colour.
 // Within a colour no two springs share a particle.
@@ -51,7 +56,8 @@ void colour(SpringSet& set, std::size_t particles) {
   }
   std::vector<std::size_t> order(set.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t l, std::size_t r) { return colourOf[l] < colourOf[r]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t l, std::size_t r) { return colourOf[l] < colourOf[r]; });
   SpringSet sorted;
   sorted.colourStart.assign(colours + 1, 0);
   for (std::size_t k : order) {
@@ -68,8 +74,10 @@ SpringLayout blockLayout(const SpringSet& set, std::size_t s) {
   const auto f = [&](std::size_t k) { return static_cast<std::int64_t>(set.first[s + k]); };
   const auto g = [&](std::size_t k) { return static_cast<std::int64_t>(set.second[s + k]); };
   const bool firstContiguous = f(1) == f(0) + 1 && f(2) == f(0) + 2 && f(3) == f(0) + 3;
-  if (firstContiguous && g(1) == g(0) + 1 && g(2) == g(0) + 2 && g(3) == g(0) + 3) return SpringLayout::Contiguous;
-  if (firstContiguous && g(1) == g(0) - 1 && g(2) == g(0) + 2 && g(3) == g(0) + 1) return SpringLayout::PairSwapped;
+  if (firstContiguous && g(1) == g(0) + 1 && g(2) == g(0) + 2 && g(3) == g(0) + 3)
+    return SpringLayout::Contiguous;
+  if (firstContiguous && g(1) == g(0) - 1 && g(2) == g(0) + 2 && g(3) == g(0) + 1)
+    return SpringLayout::PairSwapped;
   bool interleaved = true, pairs = true;
   constexpr std::int64_t kPairOffset[4] = {0, 1, 4, 5};
   for (std::size_t k = 0; k < 4; ++k) {
@@ -182,7 +190,8 @@ FabricResult Fabric::fromMesh(const MeshDesc& d) {
   FabricResult result;
   const std::size_t n = d.positions.size();
   if (n < 3 || d.triangles.empty() || d.triangles.size() % 3 != 0) {
-    result.status = Status::error("Fabric::fromMesh: needs at least one triangle (3 indices each) over 3+ vertices");
+    result.status =
+        Status::error("Fabric::fromMesh: needs at least one triangle (3 indices each) over 3+ vertices");
     return result;
   }
   if (!finitePositive(d.totalMass)) {
@@ -201,7 +210,8 @@ FabricResult Fabric::fromMesh(const MeshDesc& d) {
   }
   for (std::uint32_t i : d.triangles) {
     if (i >= n) {
-      result.status = Status::error("Fabric::fromMesh: triangle index " + std::to_string(i) + " out of range");
+      result.status =
+          Status::error("Fabric::fromMesh: triangle index " + std::to_string(i) + " out of range");
       return result;
     }
   }
@@ -219,7 +229,8 @@ FabricResult Fabric::fromMesh(const MeshDesc& d) {
   for (std::size_t t = 0; t < d.triangles.size(); t += 3) {
     const std::uint32_t v[3] = {d.triangles[t], d.triangles[t + 1], d.triangles[t + 2]};
     if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) {
-      result.status = Status::error("Fabric::fromMesh: triangle " + std::to_string(t / 3) + " repeats a vertex");
+      result.status =
+          Status::error("Fabric::fromMesh: triangle " + std::to_string(t / 3) + " repeats a vertex");
       return result;
     }
     const double a = 0.5 * (d.positions[v[1]] - d.positions[v[0]])
@@ -242,7 +253,8 @@ FabricResult Fabric::fromMesh(const MeshDesc& d) {
   for (std::size_t i = 0; i < n; ++i) {
     const double m = d.totalMass * area[static_cast<Eigen::Index>(i)] / totalArea;
     if (!(m > 0.0)) {
-      result.status = Status::error("Fabric::fromMesh: vertex " + std::to_string(i) + " belongs to no triangle of nonzero area");
+      result.status = Status::error("Fabric::fromMesh: vertex " + std::to_string(i) +
+                                    " belongs to no triangle of nonzero area");
       return result;
     }
     f->masses_[static_cast<Eigen::Index>(i)] = static_cast<float>(m);
@@ -282,33 +294,41 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
     const SpringSet& structural = springs_[static_cast<int>(SpringFamily::Structural)];
     double sum = 0.0;
     for (float l : structural.restLength) sum += l;
-    meanSpacing_ = structural.size() > 0 ? static_cast<float>(sum / static_cast<double>(structural.size())) : 0.01f;
+    meanSpacing_ =
+        structural.size() > 0 ? static_cast<float>(sum / static_cast<double>(structural.size())) : 0.01f;
   }
   buildTriangleTables();
   return buildTethers(anchors, tethersPerParticle, tetherScale);
 }
 
-Status Fabric::buildTethers(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale) {
+Status Fabric::buildTethers(const std::vector<std::uint32_t>& anchors, int tethersPerParticle,
+                            float tetherScale) {
   const std::size_t n = particleCount();
   if (!anchors.empty()) {
     if (tethersPerParticle < 1) return Status::error("Fabric: tethersPerParticle must be >= 1");
-    if (!(std::isfinite(tetherScale) && tetherScale >= 1.0f)) return Status::error("Fabric: tetherScale must be >= 1");
+    if (!(std::isfinite(tetherScale) && tetherScale >= 1.0f))
+      return Status::error("Fabric: tetherScale must be >= 1");
     for (std::uint32_t a : anchors)
       if (a >= n) return Status::error("Fabric: tether anchor " + std::to_string(a) + " out of range");
     std::vector<std::uint32_t> sortedAnchors = anchors;
     std::sort(sortedAnchors.begin(), sortedAnchors.end());
     sortedAnchors.erase(std::unique(sortedAnchors.begin(), sortedAnchors.end()), sortedAnchors.end());
-    const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(tethersPerParticle), sortedAnchors.size());
+    const std::size_t k =
+        std::min<std::size_t>(static_cast<std::size_t>(tethersPerParticle), sortedAnchors.size());
     std::vector<std::pair<float, std::uint32_t>> byDistance(sortedAnchors.size());
     std::vector<std::vector<std::pair<std::uint32_t, std::pair<float, std::uint32_t>>>> nearest(k);
     for (std::size_t i = 0; i < n; ++i) {
-      if (std::binary_search(sortedAnchors.begin(), sortedAnchors.end(), static_cast<std::uint32_t>(i))) continue;
+      if (std::binary_search(sortedAnchors.begin(), sortedAnchors.end(), static_cast<std::uint32_t>(i)))
+        continue;
       for (std::size_t a = 0; a < sortedAnchors.size(); ++a) {
-        byDistance[a] = {(restPositions_.row(static_cast<Eigen::Index>(i)) - restPositions_.row(sortedAnchors[a])).norm(),
-                         sortedAnchors[a]};
+        byDistance[a] = {
+            (restPositions_.row(static_cast<Eigen::Index>(i)) - restPositions_.row(sortedAnchors[a])).norm(),
+            sortedAnchors[a]};
       }
-      std::partial_sort(byDistance.begin(), byDistance.begin() + static_cast<std::ptrdiff_t>(k), byDistance.end());
-      for (std::size_t j = 0; j < k; ++j) nearest[j].push_back({static_cast<std::uint32_t>(i), byDistance[j]});
+      std::partial_sort(byDistance.begin(), byDistance.begin() + static_cast<std::ptrdiff_t>(k),
+                        byDistance.end());
+      for (std::size_t j = 0; j < k; ++j)
+        nearest[j].push_back({static_cast<std::uint32_t>(i), byDistance[j]});
     }
     // Nearest anchors of every particle first, then the second nearest...: consecutive tethers then belong to
     // different particles and do not wait on each other in the solver.

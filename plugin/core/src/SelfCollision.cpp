@@ -30,7 +30,8 @@ namespace cape::detail {
 namespace {
 
 /// Barycentric weights of p's projection onto the plane of (a, b, c), unclamped; false if degenerate.
-bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float& wa, float& wb, float& wc) {
+bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float& wa, float& wb,
+                      float& wc) {
   const Vec3 v0 = b - a, v1 = c - a, v2 = p - a;
   const float d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
   const float den = d00 * d11 - d01 * d01;
@@ -46,9 +47,13 @@ bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c
 /// other layer (two halves of a folded grid line up exactly) is caught as surely as one heading for a face.
 constexpr float kFaceMargin = 0.25f;
 
-inline bool overFace(float wa, float wb, float wc) { return wa >= -kFaceMargin && wb >= -kFaceMargin && wc >= -kFaceMargin; }
+inline bool overFace(float wa, float wb, float wc) {
+  return wa >= -kFaceMargin && wb >= -kFaceMargin && wc >= -kFaceMargin;
+}
 
-inline Vec3 at(const Points& x, std::uint32_t i) { return Vec3(x(i, 0), x(i, 1), x(i, 2)); }
+inline Vec3 at(const Points& x, std::uint32_t i) {
+  return Vec3(x(i, 0), x(i, 1), x(i, 2));
+}
 
 // A hash entry keeps its cluster's index in the unused fourth lane of the box's low corner, as the bits of
 // a float that every comparison below passes (fewer than 2^25 clusters: a positive finite float).
@@ -64,7 +69,8 @@ inline std::uint32_t bitsIndex(float f) {
 }
 
 inline std::uint32_t bucketOf(int ix, int iy, int iz, std::uint32_t mask) {
-  const std::uint32_t h = static_cast<std::uint32_t>(ix) * 73856093u ^ static_cast<std::uint32_t>(iy) * 19349663u ^
+  const std::uint32_t h = static_cast<std::uint32_t>(ix) * 73856093u ^
+                          static_cast<std::uint32_t>(iy) * 19349663u ^
                           static_cast<std::uint32_t>(iz) * 83492791u;
   return h & mask;
 }
@@ -82,7 +88,8 @@ inline bool cellsOf(float invCell, float lx, float ly, float lz, float hx, float
     const __m128 f = _mm_mul_ps(v, scale);
     const __m128i i = _mm_cvttps_epi32(f);
     // All ones (-1) where truncation went up, i.e. below zero.
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_add_epi32(i, _mm_castps_si128(_mm_cmplt_ps(f, _mm_cvtepi32_ps(i)))));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out),
+                     _mm_add_epi32(i, _mm_castps_si128(_mm_cmplt_ps(f, _mm_cvtepi32_ps(i)))));
   };
   floorCells(_mm_setr_ps(lx, ly, lz, lz), c);
   floorCells(_mm_setr_ps(hx, hy, hz, hz), c + 4);
@@ -121,7 +128,6 @@ inline bool boxesOverlap(const float* qlo, const float* qhi, const float* lo, co
 
 }  // namespace
 
-
 SelfCollision::SelfCollision(const Fabric& fabric) : fabric_(fabric) {
   const std::size_t n = fabric.particleCount(), triangles = fabric.triangleCount();
   // A hash of at least twice as many buckets as particles (a power of two).
@@ -149,8 +155,8 @@ float SelfCollision::thickness(const CapeSettings& settings) const {
                                                 : kAutoThickness * fabric_.meanSpacing();
 }
 
-int SelfCollision::schedule(const CapeState& state, const Eigen::VectorXf& freeMask, const CapeSettings& settings,
-                            float dt, int substeps) {
+int SelfCollision::schedule(const CapeState& state, const Eigen::VectorXf& freeMask,
+                            const CapeSettings& settings, float dt, int substeps) {
   // Self-contacts are found from where the cape is now and kept through the substeps. One search covers at
   // most a spacing of motion (relative to the cape's rigid motion) and at most one settings.timeStep. A
   // calm cape (no particle faster than a spacing per timeStep) searches once per timeStep: a world stepping
@@ -173,19 +179,23 @@ int SelfCollision::schedule(const CapeState& state, const Eigen::VectorXf& freeM
   // Enough searches that none covers more than kSearchMotion spacings; every substep at most (and for a
   // non-finite motion, whose search finds nothing: find() leaves a blown-up cape alone).
   const float wanted = fastest * dt / (kSearchMotion * spacing);
-  const int searches = std::isfinite(wanted) ? static_cast<int>(std::clamp(std::ceil(wanted), 1.0f, static_cast<float>(substeps))) : substeps;
+  const int searches =
+      std::isfinite(wanted)
+          ? static_cast<int>(std::clamp(std::ceil(wanted), 1.0f, static_cast<float>(substeps)))
+          : substeps;
   validUntil_ = state.time + static_cast<double>(dt);
   return (substeps + searches - 1) / searches;
 }
 
-void SelfCollision::searchFor(const CapeState& state, const Eigen::VectorXf& freeMask, const CapeSettings& settings,
-                              float window) {
+void SelfCollision::searchFor(const CapeState& state, const Eigen::VectorXf& freeMask,
+                              const CapeSettings& settings, float window) {
   predictMotion(state, freeMask, settings.gravity, window);
   find(state.positions, state.velocities, thickness(settings));
   ++searches_;
 }
 
-float SelfCollision::predictMotion(const CapeState& state, const Eigen::VectorXf& freeMask, const Vec3& gravity, float dt) {
+float SelfCollision::predictMotion(const CapeState& state, const Eigen::VectorXf& freeMask,
+                                   const Vec3& gravity, float dt) {
   // How far each particle may move in dt, v dt + g dt^2 / 2 (pinned particles move at the velocity their
   // pin gave them), less a rigid motion of the whole cape: a rigid motion changes no distance, so only what
   // is left can bring a particle closer to a triangle. The rigid motion is the least-squares fit of a
@@ -223,7 +233,8 @@ float SelfCollision::predictMotion(const CapeState& state, const Eigen::VectorXf
     const float angle = theta.norm();
     // Any rigid motion keeps the bound exact; a poor fit (or none) only makes it looser.
     if (std::isfinite(angle) && angle > 0.0f && angle < 1.0f)
-      rotationMinusIdentity = Eigen::AngleAxisf(angle, theta / angle).toRotationMatrix() - Eigen::Matrix3f::Identity();
+      rotationMinusIdentity =
+          Eigen::AngleAxisf(angle, theta / angle).toRotationMatrix() - Eigen::Matrix3f::Identity();
   }
   const Eigen::Matrix3f& k = rotationMinusIdentity;
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -247,7 +258,8 @@ void SelfCollision::grownBox(std::uint32_t t, Vec3& lo, Vec3& hi) const {
   hi = a.cwiseMax(b).cwiseMax(c).array() + grow;
 }
 
-CAPE_ALWAYS_INLINE inline void SelfCollision::consider(std::uint32_t q, const Vec3& p, std::uint32_t t, bool stamp) {
+CAPE_ALWAYS_INLINE inline void SelfCollision::consider(std::uint32_t q, const Vec3& p, std::uint32_t t,
+                                                       bool stamp) {
   // One particle against one triangle whose grown box its motion's box overlaps: the exact filter, and the
   // contact with the side it is on.
   if (isLocal(fabric_.triangleLocal()[t], q)) return;
@@ -263,7 +275,8 @@ CAPE_ALWAYS_INLINE inline void SelfCollision::consider(std::uint32_t q, const Ve
   const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
   const Vec3 a = at(x, ia), b = at(x, ib), c = at(x, ic);
   const Vec3 centroid = (a + b + c) / 3.0f;
-  const float radius = std::sqrt(std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()}));
+  const float radius = std::sqrt(
+      std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()}));
   const float d2 = (p - centroid).squaredNorm();
   const float loose = thickness_ + slack_ + stepMotionNorm_[q] + triangleMotion_[t] + radius;
   if (d2 > loose * loose) return;
@@ -311,7 +324,8 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
       for (std::size_t t = 0; t < triangles; ++t) {
         Vec3 tlo, thi;
         grownBox(static_cast<std::uint32_t>(t), tlo, thi);
-        if (boxesOverlap(qlo, qhi, tlo.data(), thi.data())) consider(q, p, static_cast<std::uint32_t>(t), false);
+        if (boxesOverlap(qlo, qhi, tlo.data(), thi.data()))
+          consider(q, p, static_cast<std::uint32_t>(t), false);
       }
       continue;
     }
@@ -319,7 +333,8 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
     const bool stamp = range[4] > range[0] || range[5] > range[1] || range[6] > range[2];
     for (int ix = range[0]; ix <= range[4]; ++ix)
       for (int iy = range[1]; iy <= range[5]; ++iy)
-        for (int iz = range[2]; iz <= range[6]; ++iz) scanBucket(q, p, qlo, qhi, bucketOf(ix, iy, iz, mask_), stamp);
+        for (int iz = range[2]; iz <= range[6]; ++iz)
+          scanBucket(q, p, qlo, qhi, bucketOf(ix, iy, iz, mask_), stamp);
     for (const std::uint32_t t : largeTriangles_) {
       Vec3 tlo, thi;
       grownBox(t, tlo, thi);
@@ -330,7 +345,8 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
 
 void SelfCollision::bin() {
   // Bin the triangles, each grown by the thickness, the slack and its own motion, into the cells of a hashed
-  // grid. Binned by cluster (the two triangles of a grid cell share its box): half the entries of binning each.
+  // grid. Binned by cluster (the two triangles of a grid cell share its box): half the entries of binning
+  // each.
   const std::vector<std::uint32_t>& tri = fabric_.triangles();
   const std::vector<std::uint32_t>& clusterStart = fabric_.clusterStart();
   const std::uint32_t buckets = static_cast<std::uint32_t>(hashStart_.size() - 1);
@@ -343,7 +359,8 @@ void SelfCollision::bin() {
     clusterBucketStart_[g] = static_cast<std::uint32_t>(clusterBuckets_.size());
     Vec3 lo = Vec3::Constant(std::numeric_limits<float>::max()), hi = -lo;
     for (std::uint32_t t = clusterStart[g]; t < clusterStart[g + 1]; ++t) {
-      triangleMotion_[t] = std::max({stepMotionNorm_[tri[3 * t]], stepMotionNorm_[tri[3 * t + 1]], stepMotionNorm_[tri[3 * t + 2]]});
+      triangleMotion_[t] = std::max(
+          {stepMotionNorm_[tri[3 * t]], stepMotionNorm_[tri[3 * t + 1]], stepMotionNorm_[tri[3 * t + 2]]});
       Vec3 tlo, thi;
       grownBox(t, tlo, thi);
       lo = lo.cwiseMin(tlo);
@@ -374,7 +391,7 @@ void SelfCollision::bin() {
   }
   clusterBucketStart_[clusters] = static_cast<std::uint32_t>(clusterBuckets_.size());
   for (std::uint32_t b = 0; b < buckets; ++b) hashStart_[b + 1] += hashStart_[b];  // [b] = start of bucket b
-  if (hashEntries_.size() < hashStart_[buckets]) {  // grows rarely
+  if (hashEntries_.size() < hashStart_[buckets]) {                                 // grows rarely
     hashEntries_.resize(hashStart_[buckets]);
     bucketHits_.resize(hashStart_[buckets]);
   }
@@ -382,7 +399,8 @@ void SelfCollision::bin() {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   for (std::size_t g = 0; g < clusters; ++g) {
     const float* box = &clusterBoxes_[6 * g];
-    const HashEntry entry{{box[0], box[1], box[2], indexBits(static_cast<std::uint32_t>(g))}, {box[3], box[4], box[5], kInf}};
+    const HashEntry entry{{box[0], box[1], box[2], indexBits(static_cast<std::uint32_t>(g))},
+                          {box[3], box[4], box[5], kInf}};
     for (std::uint32_t k = clusterBucketStart_[g]; k < clusterBucketStart_[g + 1]; ++k)
       hashEntries_[hashStart_[clusterBuckets_[k]]++] = entry;
   }
@@ -402,13 +420,15 @@ void SelfCollision::scanBucket(std::uint32_t q, const Vec3& p, const float* qlo,
   std::uint32_t hits = 0;
 #if defined(__SSE2__)
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  const __m128 queryLo = _mm_setr_ps(qlo[0], qlo[1], qlo[2], -kInf), queryHi = _mm_setr_ps(qhi[0], qhi[1], qhi[2], kInf);
+  const __m128 queryLo = _mm_setr_ps(qlo[0], qlo[1], qlo[2], -kInf),
+               queryHi = _mm_setr_ps(qhi[0], qhi[1], qhi[2], kInf);
   const __m128i self = _mm_set1_epi32(static_cast<int>(q));
 #endif
   for (std::uint32_t e = 0; e < count; ++e) {
     found[hits] = e;
 #if defined(__SSE2__)
-    const __m128 inside = _mm_and_ps(_mm_cmpge_ps(queryHi, _mm_load_ps(entry[e].lo)), _mm_cmple_ps(queryLo, _mm_load_ps(entry[e].hi)));
+    const __m128 inside = _mm_and_ps(_mm_cmpge_ps(queryHi, _mm_load_ps(entry[e].lo)),
+                                     _mm_cmple_ps(queryLo, _mm_load_ps(entry[e].hi)));
     hits += _mm_movemask_ps(inside) == 0xF ? 1u : 0u;
 #else
     hits += boxesOverlap(qlo, qhi, entry[e].lo, entry[e].hi) ? 1u : 0u;
@@ -419,7 +439,8 @@ void SelfCollision::scanBucket(std::uint32_t q, const Vec3& p, const float* qlo,
     const std::uint32_t g = bitsIndex(entry[found[k]].lo[3]);
     const std::uint32_t* l = fabric_.clusterLocal()[g].v;
 #if defined(__SSE2__)
-    if (_mm_movemask_epi8(_mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(l)), self)) != 0) continue;
+    if (_mm_movemask_epi8(_mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(l)), self)) != 0)
+      continue;
 #else
     if ((q == l[0]) | (q == l[1]) | (q == l[2]) | (q == l[3])) continue;
 #endif
@@ -469,7 +490,8 @@ void SelfCollision::solve(Points& x, const float* w, float thickness) {
     if (distance >= thickness) continue;
     // PBD point-triangle constraint C = n . (p - sum w_k x_k) - thickness >= 0, gradients n and -w_k n.
     const float invP = w[k.particle], invA = w[ia], invB = w[ib], invC = w[ic];
-    const float denominator = invP + bary.wa * bary.wa * invA + bary.wb * bary.wb * invB + bary.wc * bary.wc * invC;
+    const float denominator =
+        invP + bary.wa * bary.wa * invA + bary.wb * bary.wb * invB + bary.wc * bary.wc * invC;
     if (!(denominator > 0.0f)) continue;
     const Vec3 step = ((thickness - distance) / denominator) * normal;
     x.row(k.particle) += invP * step.transpose();

@@ -19,8 +19,8 @@ class SelfCollision {
   /// Plans this step's searches (see the definition for the rule). Returns the substeps between searches,
   /// or 0 when no search runs inside the substep loop (one ran here, or the earlier contacts still cover
   /// the step).
-  int schedule(const CapeState& state, const Eigen::VectorXf& freeMask, const CapeSettings& settings, float dt,
-               int substeps);
+  int schedule(const CapeState& state, const Eigen::VectorXf& freeMask, const CapeSettings& settings,
+               float dt, int substeps);
   /// A search inside the substep loop covering `window` seconds of motion.
   void searchFor(const CapeState& state, const Eigen::VectorXf& freeMask, const CapeSettings& settings,
                  float window);
@@ -46,8 +46,8 @@ class SelfCollision {
 
   const Fabric& fabric_;
   std::vector<Cape::SelfContact> contacts_;
-  double validUntil_ = -1.0;   ///< s: the contacts cover the motion until this time.
-  std::uint64_t searches_ = 0; ///< Searches so far (diagnostics).
+  double validUntil_ = -1.0;    ///< s: the contacts cover the motion until this time.
+  std::uint64_t searches_ = 0;  ///< Searches so far (diagnostics).
 
   // The search's scratch, sized once.
   std::vector<std::uint32_t> hashStart_;  ///< Spatial hash: bucket offsets (buckets + 1).
@@ -57,17 +57,17 @@ class SelfCollision {
     float lo[4];  ///< [3]: the cluster's index, as float bits
     float hi[4];  ///< [3]: +inf
   };
-  std::vector<HashEntry> hashEntries_;     ///< Spatial hash: clusters of triangles sorted by bucket.
-  std::vector<std::uint32_t> bucketHits_;  ///< One bucket's entries that overlap (hashEntries_ size).
-  std::vector<float> triangleMotion_;      ///< Per triangle: the largest motion of its corners, m.
-  std::vector<std::uint32_t> triangleStamp_;   ///< Last particle that met each triangle in the search.
-  std::vector<std::uint32_t> largeTriangles_;  ///< Triangles whose grown box is too big to bin.
-  std::vector<float> clusterBoxes_;            ///< Per cluster: the union of its grown boxes, m.
+  std::vector<HashEntry> hashEntries_;             ///< Spatial hash: clusters of triangles sorted by bucket.
+  std::vector<std::uint32_t> bucketHits_;          ///< One bucket's entries that overlap (hashEntries_ size).
+  std::vector<float> triangleMotion_;              ///< Per triangle: the largest motion of its corners, m.
+  std::vector<std::uint32_t> triangleStamp_;       ///< Last particle that met each triangle in the search.
+  std::vector<std::uint32_t> largeTriangles_;      ///< Triangles whose grown box is too big to bin.
+  std::vector<float> clusterBoxes_;                ///< Per cluster: the union of its grown boxes, m.
   std::vector<std::uint32_t> clusterBuckets_;      ///< The buckets each binned cluster went into...
   std::vector<std::uint32_t> clusterBucketStart_;  ///< ...from this offset per cluster (clusters + 1).
   std::vector<std::uint32_t> bucketCluster_;       ///< The last cluster binned into each bucket.
-  Points stepMotion_;              ///< Predicted displacement over the search's window, less a rigid motion, m.
-  Eigen::VectorXf stepMotionNorm_; ///< |stepMotion_| per particle, m.
+  Points stepMotion_;  ///< Predicted displacement over the search's window, less a rigid motion, m.
+  Eigen::VectorXf stepMotionNorm_;  ///< |stepMotion_| per particle, m.
 
   // Per search: what every particle's scan reads.
   const Points* x_ = nullptr;

@@ -10,7 +10,9 @@
 
 namespace cape::detail {
 
-inline Vec3 axisVector(int axis) { return Vec3::Unit(axis); }
+inline Vec3 axisVector(int axis) {
+  return Vec3::Unit(axis);
+}
 
 // The unit vector of p, or a fixed fallback when p is (nearly) zero, so that the push-out direction is always
 // defined and deterministic.
@@ -42,8 +44,8 @@ inline SurfaceDistance cylinderDistance(float r, float hh, int axis, const Vec3&
   radial[axis] = 0.0f;
   const float rho = radial.norm();
   const Vec3 radialDir = directionOr(radial, axis == 0 ? Vec3::UnitY() : Vec3::UnitX());
-  const float dr = rho - r;              // > 0 outside the infinite cylinder
-  const float da = std::abs(t) - hh;     // > 0 beyond the caps
+  const float dr = rho - r;           // > 0 outside the infinite cylinder
+  const float da = std::abs(t) - hh;  // > 0 beyond the caps
   const Vec3 capNormal = (t >= 0.0f ? 1.0f : -1.0f) * axisVector(axis);
   if (dr <= 0.0f && da <= 0.0f) {
     if (dr > da) return {dr, radialDir};

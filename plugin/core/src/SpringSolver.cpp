@@ -9,7 +9,8 @@
 
 namespace cape::detail {
 
-void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde) {
+void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end,
+                        float alphaTilde) {
   float* __restrict px = a.px;
   float* __restrict py = a.py;
   float* __restrict pz = a.pz;
@@ -86,7 +87,7 @@ struct Lanes<SpringLayout::PairSwapped> {
   static void load(const float* x, const std::uint32_t* i, const std::uint32_t* j, __m128& vi, __m128& vj) {
     const std::uint32_t p = i[0], q = j[0];
     vi = _mm_loadu_ps(x + p);
-    const __m128 t = _mm_loadu_ps(x + q - 1);  // x[q-1], x[q], x[q+1], x[q+2]
+    const __m128 t = _mm_loadu_ps(x + q - 1);            // x[q-1], x[q], x[q+1], x[q+2]
     vj = _mm_shuffle_ps(t, t, _MM_SHUFFLE(2, 3, 0, 1));  // x[q], x[q-1], x[q+2], x[q+1]
   }
   static void store(float* x, const std::uint32_t* i, const std::uint32_t* j, __m128 vi, __m128 vj) {
@@ -169,8 +170,9 @@ void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t 
     const __m128 active = _mm_cmpgt_ps(len2, minLen2);  // false for NaN too
     const __m128 len = _mm_sqrt_ps(len2);
     const __m128 lambda = _mm_loadu_ps(a.lambda + s);
-    const __m128 dl = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(a.restLength + s), len), _mm_mul_ps(alpha, lambda)),
-                                 _mm_loadu_ps(a.invDenominator + s));
+    const __m128 dl =
+        _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(a.restLength + s), len), _mm_mul_ps(alpha, lambda)),
+                   _mm_loadu_ps(a.invDenominator + s));
     _mm_storeu_ps(a.lambda + s, select(active, _mm_add_ps(lambda, dl), lambda));
     const __m128 k = _mm_div_ps(dl, len);
     const __m128 cx = _mm_mul_ps(k, dx), cy = _mm_mul_ps(k, dy), cz = _mm_mul_ps(k, dz);
@@ -208,9 +210,9 @@ void solveTethers(float* px, float* py, float* pz, const float* inverseMass, con
     const __m128 dx = _mm_sub_ps(xp, xa), dy = _mm_sub_ps(yp, ya), dz = _mm_sub_ps(zp, za);
     const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
     const __m128 maxLen = _mm_loadu_ps(maxLength + k);
-    const __m128 taut = _mm_and_ps(_mm_and_ps(_mm_cmpeq_ps(gather(w, anchor + k), zero),
-                                              _mm_cmpneq_ps(_mm_loadu_ps(w + p), zero)),
-                                   _mm_cmpgt_ps(len2, _mm_mul_ps(maxLen, maxLen)));
+    const __m128 taut = _mm_and_ps(
+        _mm_and_ps(_mm_cmpeq_ps(gather(w, anchor + k), zero), _mm_cmpneq_ps(_mm_loadu_ps(w + p), zero)),
+        _mm_cmpgt_ps(len2, _mm_mul_ps(maxLen, maxLen)));
     // max(tiny, len2) is len2 when len2 is NaN, as std::max(len2, tiny) is.
     const __m128 scale = _mm_div_ps(maxLen, _mm_sqrt_ps(_mm_max_ps(tiny, len2)));
     _mm_storeu_ps(px + p, select(taut, _mm_add_ps(xa, _mm_mul_ps(dx, scale)), xp));
@@ -222,12 +224,18 @@ void solveTethers(float* px, float* py, float* pz, const float* inverseMass, con
 
 void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
   switch (run.layout) {
-    case SpringLayout::Contiguous: return solveBlocks<SpringLayout::Contiguous>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::PairSwapped: return solveBlocks<SpringLayout::PairSwapped>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Interleaved: return solveBlocks<SpringLayout::Interleaved>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Pairs: return solveBlocks<SpringLayout::Pairs>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Gathered: return solveBlocks<SpringLayout::Gathered>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Scalar: break;
+    case SpringLayout::Contiguous:
+      return solveBlocks<SpringLayout::Contiguous>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::PairSwapped:
+      return solveBlocks<SpringLayout::PairSwapped>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Interleaved:
+      return solveBlocks<SpringLayout::Interleaved>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Pairs:
+      return solveBlocks<SpringLayout::Pairs>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Gathered:
+      return solveBlocks<SpringLayout::Gathered>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Scalar:
+      break;
   }
   solveSpringsScalar(a, run.begin, run.end, alphaTilde);
 }

@@ -70,7 +70,8 @@ constexpr float kCrossWind = 0.3f;
 
 /// The gust signal of one component at a time: phase argument wrapped to keep float precision over long runs.
 float wrappedPhase(const Wave& w, double time) {
-  return static_cast<float>(std::fmod(static_cast<double>(w.omega) * time + static_cast<double>(w.phase), kTwoPi));
+  return static_cast<float>(
+      std::fmod(static_cast<double>(w.omega) * time + static_cast<double>(w.phase), kTwoPi));
 }
 
 }  // namespace
@@ -84,18 +85,23 @@ Vec3 windVelocity(const WindSettings& wind, const Vec3& point, double time) {
 
 void windVelocities(const WindSettings& wind, const Points& points, double time, Points& out) {
   switch (wind.model) {
-    case WindSettings::Model::None: out.setZero(); return;
+    case WindSettings::Model::None:
+      out.setZero();
+      return;
     case WindSettings::Model::SineWave: {
-      const Vec3 v = wind.direction.normalized() * wind.speed *
-                     (1.0f + wind.gustAmplitude * static_cast<float>(std::sin(kTwoPi * wind.gustFrequency * time)));
+      const Vec3 v =
+          wind.direction.normalized() * wind.speed *
+          (1.0f + wind.gustAmplitude * static_cast<float>(std::sin(kTwoPi * wind.gustFrequency * time)));
       out.rowwise() = v.transpose();
       return;
     }
-    case WindSettings::Model::Aerodynamic: break;
+    case WindSettings::Model::Aerodynamic:
+      break;
   }
   const GustField f = makeField(wind);
   const Eigen::Index n = points.rows();
-  Eigen::Map<const Eigen::ArrayXf> X(points.col(0).data(), n), Y(points.col(1).data(), n), Z(points.col(2).data(), n);
+  Eigen::Map<const Eigen::ArrayXf> X(points.col(0).data(), n), Y(points.col(1).data(), n),
+      Z(points.col(2).data(), n);
   // The three gust signals first, in place in `out` (no scratch, no allocation)...
   for (int c = 0; c < 3; ++c) {
     auto g = out.col(c).array();
@@ -117,8 +123,8 @@ void windVelocities(const WindSettings& wind, const Points& points, double time,
   }
 }
 
-Vec3 aerodynamicForce(const Vec3& relativeAir, const Vec3& areaNormal, float airDensity, float dragCoefficient,
-                      float liftCoefficient) {
+Vec3 aerodynamicForce(const Vec3& relativeAir, const Vec3& areaNormal, float airDensity,
+                      float dragCoefficient, float liftCoefficient) {
   const float area = areaNormal.norm();
   const float speed = relativeAir.norm();
   if (!(area > 0.0f) || !(speed > 0.0f)) return Vec3::Zero();

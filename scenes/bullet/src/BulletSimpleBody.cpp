@@ -14,13 +14,18 @@ BulletSimpleBody::BulletSimpleBody(btDynamicsWorld& world, const Vec3& offset, c
     const Collider& col = colliders[static_cast<std::size_t>(i)];
     std::unique_ptr<btCollisionShape> shape;
     switch (col.shape) {
-      case ColliderShape::Box: shape = std::make_unique<btBoxShape>(toBt(col.halfExtents)); break;
-      case ColliderShape::Sphere: shape = std::make_unique<btSphereShape>(btScalar(col.radius)); break;
+      case ColliderShape::Box:
+        shape = std::make_unique<btBoxShape>(toBt(col.halfExtents));
+        break;
+      case ColliderShape::Sphere:
+        shape = std::make_unique<btSphereShape>(btScalar(col.radius));
+        break;
       case ColliderShape::Capsule:
         // Bullet's capsule height is the cylinder between the caps: twice the collider's half height.
         shape = std::make_unique<btCapsuleShape>(btScalar(col.radius), btScalar(2.0f * col.halfHeight));
         break;
-      default: break;  // the simple body has no other shapes
+      default:
+        break;  // the simple body has no other shapes
     }
     auto state = std::make_unique<btDefaultMotionState>(toBt(col.current));
     btRigidBody::btRigidBodyConstructionInfo info(btScalar(0), state.get(), shape.get());
@@ -43,7 +48,8 @@ BulletSimpleBody::~BulletSimpleBody() {
 void BulletSimpleBody::moveTo(const BodyPose& pose) {
   body_.moveTo(pose);
   // Kinematic bodies follow their motion states; Bullet derives their velocities in stepSimulation.
-  for (std::size_t i = 0; i < bodies_.size(); ++i) states_[i]->setWorldTransform(toBt(body_.colliders()[i].current));
+  for (std::size_t i = 0; i < bodies_.size(); ++i)
+    states_[i]->setWorldTransform(toBt(body_.colliders()[i].current));
 }
 
 }  // namespace cape

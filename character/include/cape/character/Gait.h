@@ -30,10 +30,10 @@
 namespace cape::character {
 
 struct GaitParams {
-  double speed = 0.0;     ///< m/s along the heading
-  double turnRate = 0.0;  ///< rad/s about world +Y (positive turns to the character's left)
-  double stepFrequency =
-      0.0;  ///< Hz: full leg cycles per second (one left and one right step), docs/SCENES.md's "legs swing at"
+  double speed = 0.0;            ///< m/s along the heading
+  double turnRate = 0.0;         ///< rad/s about world +Y (positive turns to the character's left)
+  double stepFrequency = 0.0;    ///< Hz: full leg cycles per second (one left and one right step),
+                                 ///< docs/SCENES.md's "legs swing at"
   double bobAmplitude = 0.0;     ///< m, half the peak-to-peak torso bob (the whole body rises and falls)
   double bobFrequency = 0.0;     ///< Hz, usually 2 * stepFrequency (one bob per step)
   double hipAmplitude = 0.5236;  ///< rad, A above

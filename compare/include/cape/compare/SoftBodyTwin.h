@@ -89,8 +89,8 @@ class DeformableTwin {
 
 /// Builds the deformable twin of `cape` from its current state and attachments and adds it to `world`;
 /// nullptr if the cape is not ok. Anchors are Bullet's deformable anchors to the attachment bodies.
-std::unique_ptr<DeformableTwin> makeDeformableTwin(btDeformableMultiBodyDynamicsWorld& world,
-                                                   const bullet::CapeAction& cape,
-                                                   const DeformableTwinSettings& settings = DeformableTwinSettings());
+std::unique_ptr<DeformableTwin> makeDeformableTwin(
+    btDeformableMultiBodyDynamicsWorld& world, const bullet::CapeAction& cape,
+    const DeformableTwinSettings& settings = DeformableTwinSettings());
 
 }  // namespace cape::compare

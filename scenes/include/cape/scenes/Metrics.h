@@ -11,7 +11,8 @@ namespace cape {
 /// Strain as docs/SCENES.md defines it, signed: a stretched spring's strain is positive, a compressed one's
 /// negative. The one measure of strain outside the solver (tests, demos and the comparison all use it).
 struct StrainStats {
-  float max = 0.0f;   ///< max over structural springs of (|xi - xj| - L0) / L0 (negative if all are compressed)
+  float max =
+      0.0f;  ///< max over structural springs of (|xi - xj| - L0) / L0 (negative if all are compressed)
   float mean = 0.0f;  ///< mean of the same (signed)
 };
 /// Strain of the structural springs at the given positions; 0 and 0 for a fabric with none.
@@ -58,12 +59,12 @@ struct FrameMetrics {
   bool blowUp = false;
 };
 
-/// Measures a frame of any solver's cloth on `fabric` (ours, or a Bullet twin copied into these arrays), so that
-/// every solver compared is measured by the same code: `positions` and `velocities` have one row per fabric
-/// particle (m, m/s); `pins` are the pinned particles with where each should be now (`target`; the previous
-/// target is not read); `bodyColliders` are at this frame's poses; `torsoCentre` is where the blow-up radius
-/// is measured from. A blown-up frame only says so (`blowUp`; every other figure left 0, as they would be
-/// NaN or meaningless). Self-intersections are only counted when a counter is given.
+/// Measures a frame of any solver's cloth on `fabric` (ours, or a Bullet twin copied into these arrays), so
+/// that every solver compared is measured by the same code: `positions` and `velocities` have one row per
+/// fabric particle (m, m/s); `pins` are the pinned particles with where each should be now (`target`; the
+/// previous target is not read); `bodyColliders` are at this frame's poses; `torsoCentre` is where the
+/// blow-up radius is measured from. A blown-up frame only says so (`blowUp`; every other figure left 0, as
+/// they would be NaN or meaningless). Self-intersections are only counted when a counter is given.
 FrameMetrics measureFrame(const Fabric& fabric, const Points& positions, const Points& velocities,
                           const std::vector<Pin>& pins, ColliderSpan bodyColliders, const Vec3& torsoCentre,
                           SelfIntersectionCounter* selfIntersections);
@@ -77,8 +78,8 @@ FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b);
 
 struct RunSummary {
   int frames = 0;
-  float maxStrain = 0.0f;           ///< max over frames of the per-frame max strain (signed)
-  double meanStrain = 0.0;          ///< mean over frames of the per-frame mean strain
+  float maxStrain = 0.0f;             ///< max over frames of the per-frame max strain (signed)
+  double meanStrain = 0.0;            ///< mean over frames of the per-frame mean strain
   float medianFrameMaxStrain = 0.0f;  ///< median over frames of the per-frame max strain
   float p95FrameMaxStrain = 0.0f;     ///< 95th percentile over frames of the per-frame max strain
   float maxPenetration = 0.0f;

@@ -22,15 +22,15 @@ bool parsePinLayout(const std::string& name, PinLayout& layout);
 
 /// How the character moves in a scene. Times in s, lengths in m, angles in rad.
 struct MotionDesc {
-  float speed = 0.0f;           ///< m/s along the heading
-  float legFrequency = 0.0f;    ///< Hz, one full leg swing per period
-  float legAmplitude = 0.5236f; ///< rad (30 degrees)
-  float bobAmplitude = 0.0f;    ///< m, half the peak-to-peak torso bob
-  float bobFrequency = 0.0f;    ///< Hz
-  bool turns = false;           ///< sprint-turn: 180 degrees in the last turnDuration of every turnPeriod
+  float speed = 0.0f;            ///< m/s along the heading
+  float legFrequency = 0.0f;     ///< Hz, one full leg swing per period
+  float legAmplitude = 0.5236f;  ///< rad (30 degrees)
+  float bobAmplitude = 0.0f;     ///< m, half the peak-to-peak torso bob
+  float bobFrequency = 0.0f;     ///< Hz
+  bool turns = false;            ///< sprint-turn: 180 degrees in the last turnDuration of every turnPeriod
   float turnPeriod = 2.0f;
   float turnDuration = 0.5f;
-  float duration = 10.0f;       ///< s, the scene's length
+  float duration = 10.0f;  ///< s, the scene's length
 
   static MotionDesc forScene(SceneKind kind);
 };
@@ -58,7 +58,8 @@ BodyPose motionAt(const MotionDesc& motion, double t);
 /// Collider order: torso, left shoulder, right shoulder, left leg, right leg, ground.
 class SimpleBody {
  public:
-  static constexpr int kTorso = 0, kLeftShoulder = 1, kRightShoulder = 2, kLeftLeg = 3, kRightLeg = 4, kGround = 5;
+  static constexpr int kTorso = 0, kLeftShoulder = 1, kRightShoulder = 2, kLeftLeg = 3, kRightLeg = 4,
+                       kGround = 5;
   explicit SimpleBody(const Vec3& offset = Vec3::Zero());
   /// Body colliders only (not the ground), for the penetration metric.
   ColliderSpan bodyColliders() const { return ColliderSpan(colliders_.data(), colliders_.size() - 1); }

@@ -159,8 +159,8 @@ class CapeAction : public btActionInterface {
   /// Sum of lastStepMicroseconds() over the internal steps since the last call of this function (a frame's
   /// cape time when called once per stepSimulation).
   double takeAccumulatedMicroseconds();
-  /// Pin error of SCENARIOS.md: the largest distance, m, of an attached particle from its attachment point at
-  /// the body pose of the last step's end (the pose the action drove the pin to; no body is dereferenced).
+  /// Pin error of docs/SCENES.md: the largest distance, m, of an attached particle from its attachment point
+  /// at the body pose of the last step's end (the pose the action drove the pin to; no body is dereferenced).
   btScalar maxPinError() const;
   /// True when the last step teleported the cape.
   bool teleportedLastStep() const { return teleported_; }

@@ -63,7 +63,7 @@ bool convexSignedDistance(const btConvexShape* shape, const btTransform& world, 
 
 /// Signed distance from a world point to any shape this adapter understands, m (the minimum over a
 /// compound's children; triangle meshes give the unsigned distance to the nearest triangle minus the shape
-/// margin). For metrics and tests: the "true Bullet surface" of SCENARIOS.md's penetration metric.
+/// margin). For metrics and tests: the "true Bullet surface" of docs/SCENES.md's penetration metric.
 /// Returns +infinity for shapes it cannot measure.
 btScalar shapeSignedDistance(const btCollisionShape* shape, const btTransform& world, const btVector3& point);
 

@@ -24,7 +24,8 @@ struct ColliderSpan {
   std::size_t size = 0;
   ColliderSpan() = default;
   ColliderSpan(const Collider* d, std::size_t n) : data(d), size(n) {}
-  ColliderSpan(const std::vector<Collider>& v) : data(v.data()), size(v.size()) {}  // NOLINT: implicit by design
+  ColliderSpan(const std::vector<Collider>& v)
+      : data(v.data()), size(v.size()) {}  // NOLINT: implicit by design
   const Collider* begin() const { return data; }
   const Collider* end() const { return data + size; }
 };
@@ -70,8 +71,8 @@ class Cape {
   void carry(const Eigen::Matrix3f& rotation, const Vec3& centre, const Vec3& shift);
 
   /// Advances the cape by dt seconds against the colliders, which are swept from their previous to their
-  /// current pose, in substeps of about settings().timeStep / settings().substeps (see CapeSettings::substeps).
-  /// Non-finite or non-positive dt is ignored.
+  /// current pose, in substeps of about settings().timeStep / settings().substeps (see
+  /// CapeSettings::substeps). Non-finite or non-positive dt is ignored.
   void step(float dt, ColliderSpan colliders);
 
   /// A particle that touched a collider in this substep's collision pass (index into the step's colliders).

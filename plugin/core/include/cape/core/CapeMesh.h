@@ -8,10 +8,10 @@
 namespace cape {
 
 struct CapeMesh {
-  Points positions;                     ///< m, one row per vertex.
-  Points normals;                       ///< Unit, one row per vertex.
+  Points positions;  ///< m, one row per vertex.
+  Points normals;    ///< Unit, one row per vertex.
   std::vector<Eigen::Vector2f> uvs;
-  std::vector<std::uint32_t> indices;   ///< 3 per triangle, counter-clockwise around the normal.
+  std::vector<std::uint32_t> indices;  ///< 3 per triangle, counter-clockwise around the normal.
 
   /// Sizes the buffers for the fabric (front only, or front then back when twoSided) and fills the
   /// fixed parts (triangles, UVs). Vertices [0, n) are the front; [n, 2n) the back when two-sided.
@@ -26,7 +26,8 @@ struct CapeMesh {
 };
 
 /// Area-weighted vertex normals: the normalised sum of the (unnormalised) face normals of the triangles
-/// around each vertex, whose length is twice the triangle's area. Writes into `normals` (sized by the caller).
+/// around each vertex, whose length is twice the triangle's area. Writes into `normals` (sized by the
+/// caller).
 void computeVertexNormals(const Points& positions, const std::vector<std::uint32_t>& triangles,
                           Eigen::Ref<Points, 0, Eigen::OuterStride<>> normals);
 

@@ -17,11 +17,11 @@ struct Pin {
 };
 
 struct CapeState {
-  Points positions;                ///< m, world.
-  Points velocities;               ///< m/s.
-  Eigen::VectorXf inverseMasses;   ///< 1/kg; 0 locks the particle (pins).
-  std::vector<Pin> pins;           ///< At most one pin per particle.
-  double time = 0.0;               ///< s of simulated time since the start.
+  Points positions;               ///< m, world.
+  Points velocities;              ///< m/s.
+  Eigen::VectorXf inverseMasses;  ///< 1/kg; 0 locks the particle (pins).
+  std::vector<Pin> pins;          ///< At most one pin per particle.
+  double time = 0.0;              ///< s of simulated time since the start.
 };
 
 /// FNV-1a over the bits of the positions and then the velocities: equal states give equal hashes, and a

@@ -24,7 +24,8 @@ struct ConvexHull {
   float radius = 0.0f;                  ///< m: the largest |vertex| (a bounding sphere about the origin).
 
   /// A hull from its vertices and planes; radius from the vertices.
-  static std::shared_ptr<const ConvexHull> make(std::vector<Vec3> vertices, std::vector<Eigen::Vector4f> planes);
+  static std::shared_ptr<const ConvexHull> make(std::vector<Vec3> vertices,
+                                                std::vector<Eigen::Vector4f> planes);
   /// Counts, finite values, unit normals, and every vertex on the solid side of every plane (within 0.1 mm).
   Status validate() const;
 };
@@ -59,9 +60,9 @@ struct Collider {
   Vec3 halfExtents = Vec3::Zero();
   Vec3 normal = Vec3::UnitY();
   float constant = 0.0f;
-  std::shared_ptr<const ConvexHull> hull;        ///< ConvexHull only.
-  std::shared_ptr<const TriangleSoup> triangles; ///< TriangleMesh only.
-  float thickness = 0.0f;  ///< m, >= 0.
+  std::shared_ptr<const ConvexHull> hull;         ///< ConvexHull only.
+  std::shared_ptr<const TriangleSoup> triangles;  ///< TriangleMesh only.
+  float thickness = 0.0f;                         ///< m, >= 0.
   float friction = -1.0f;  ///< Coulomb coefficient; negative means "use the cape's setting".
   Pose previous;           ///< Pose at the start of the step.
   Pose current;            ///< Pose at the end of the step.

@@ -42,9 +42,9 @@ struct SpringRun {
 /// them by colour: springs [colourStart[k], colourStart[k+1]) share no particle, so consecutive springs in
 /// the solver loop do not wait on each other (and a colour could be solved in parallel).
 struct SpringSet {
-  std::vector<std::uint32_t> first;   ///< Particle index of one end.
-  std::vector<std::uint32_t> second;  ///< Particle index of the other end.
-  std::vector<float> restLength;      ///< |x_first - x_second| at rest, m (> 0).
+  std::vector<std::uint32_t> first;        ///< Particle index of one end.
+  std::vector<std::uint32_t> second;       ///< Particle index of the other end.
+  std::vector<float> restLength;           ///< |x_first - x_second| at rest, m (> 0).
   std::vector<std::uint32_t> colourStart;  ///< Offsets of each colour, plus the end.
   /// The set cut into runs, in order (built with the colouring); no block of four straddles two colours.
   /// Solving the runs in order is solving the springs in order: the four springs of a block share no
@@ -66,12 +66,12 @@ struct TetherSet {
 
 /// How to build a rectangular grid fabric.
 struct GridDesc {
-  int columns = 20;           ///< Particles per row (>= 2).
-  int rows = 20;              ///< Particles per column (>= 2).
-  float width = 0.6f;         ///< m, along +X of the grid's local frame.
-  float height = 1.0f;        ///< m, along -Y: row 0 is the top.
-  float totalMass = 0.4f;     ///< kg, spread evenly over the particles.
-  bool bendSprings = true;    ///< Add bend springs: every second particle along rows and columns.
+  int columns = 20;         ///< Particles per row (>= 2).
+  int rows = 20;            ///< Particles per column (>= 2).
+  float width = 0.6f;       ///< m, along +X of the grid's local frame.
+  float height = 1.0f;      ///< m, along -Y: row 0 is the top.
+  float totalMass = 0.4f;   ///< kg, spread evenly over the particles.
+  bool bendSprings = true;  ///< Add bend springs: every second particle along rows and columns.
   /// Particles to which tethers are made (usually the particles that will be pinned). Empty: no tethers.
   std::vector<std::uint32_t> tetherAnchors;
   int tethersPerParticle = 2;  ///< Each particle tethers to this many nearest anchors.
@@ -80,11 +80,12 @@ struct GridDesc {
 
 /// How to build a fabric from any triangle mesh (an artist's cape).
 struct MeshDesc {
-  std::vector<Vec3> positions;           ///< Rest positions, m.
-  std::vector<std::uint32_t> triangles;  ///< Three indices per triangle, counter-clockwise seen from the front.
-  std::vector<Eigen::Vector2f> uvs;      ///< Optional, one per vertex.
-  float totalMass = 0.4f;                ///< kg, spread over vertices in proportion to their triangle area.
-  bool bendSprings = true;               ///< Far vertices of each pair of adjacent triangles.
+  std::vector<Vec3> positions;  ///< Rest positions, m.
+  std::vector<std::uint32_t>
+      triangles;                     ///< Three indices per triangle, counter-clockwise seen from the front.
+  std::vector<Eigen::Vector2f> uvs;  ///< Optional, one per vertex.
+  float totalMass = 0.4f;            ///< kg, spread over vertices in proportion to their triangle area.
+  bool bendSprings = true;           ///< Far vertices of each pair of adjacent triangles.
   std::vector<std::uint32_t> tetherAnchors;
   int tethersPerParticle = 2;
   float tetherScale = 1.0f;
@@ -119,7 +120,8 @@ class Fabric {
   /// Builds an N x M grid in its local frame: particle (r, c) has index r * columns + c and rest position
   /// (c * width / (columns - 1), -r * height / (rows - 1), 0): row-major from the top-left seen from +Z.
   /// Springs: structural (rows and columns), shear (both diagonals of every cell) — the King's graph, with
-  /// exactly 4nm - 3(n + m) + 2 springs — and optional bend springs. Two counter-clockwise triangles per cell.
+  /// exactly 4nm - 3(n + m) + 2 springs — and optional bend springs. Two counter-clockwise triangles per
+  /// cell.
   static FabricResult grid(const GridDesc& desc);
   /// Builds from a triangle mesh: every mesh edge a structural spring, the far vertices of every two
   /// triangles sharing an edge a bend spring. No shear family (the triangles' edges already brace them).
@@ -177,6 +179,8 @@ class Fabric {
 };
 
 /// The seed's spring count for an n x m King's graph: 4nm - 3(n + m) + 2.
-constexpr long kingsGraphSpringCount(long n, long m) { return 4 * n * m - 3 * (n + m) + 2; }
+constexpr long kingsGraphSpringCount(long n, long m) {
+  return 4 * n * m - 3 * (n + m) + 2;
+}
 
 }  // namespace cape

@@ -50,6 +50,8 @@ class Status {
   std::string message_;
 };
 
-inline bool isFinite(const Vec3& v) { return v.allFinite(); }
+inline bool isFinite(const Vec3& v) {
+  return v.allFinite();
+}
 
 }  // namespace cape

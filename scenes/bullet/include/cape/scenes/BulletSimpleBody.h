@@ -1,7 +1,8 @@
-// The simple body of docs/SCENES.md as kinematic Bullet rigid bodies: one per body collider of cape::SimpleBody
-// (torso box, shoulder spheres, leg capsules; not the ground plane, which a world has once for every
-// character), moved through their motion states so that Bullet derives their velocities. The Bullet scene of
-// the demos and the adapter's tests build the body with it, so both put the same bodies in the same order.
+// The simple body of docs/SCENES.md as kinematic Bullet rigid bodies: one per body collider of
+// cape::SimpleBody (torso box, shoulder spheres, leg capsules; not the ground plane, which a world has once
+// for every character), moved through their motion states so that Bullet derives their velocities. The Bullet
+// scene of the demos and the adapter's tests build the body with it, so both put the same bodies in the same
+// order.
 #pragma once
 
 #include "cape/scenes/Scene.h"
@@ -18,7 +19,8 @@ class BulletSimpleBody {
   /// Places the simple body standing at `offset` in `pose` (teleported: no sweep) and adds one kinematic,
   /// never-sleeping btRigidBody per body collider to `world`, in SimpleBody's order (kTorso, kLeftShoulder,
   /// kRightShoulder, kLeftLeg, kRightLeg), each at its collider's pose.
-  BulletSimpleBody(btDynamicsWorld& world, const Vec3& offset = Vec3::Zero(), const BodyPose& pose = BodyPose());
+  BulletSimpleBody(btDynamicsWorld& world, const Vec3& offset = Vec3::Zero(),
+                   const BodyPose& pose = BodyPose());
   /// Removes the bodies from the world (the world must still exist).
   ~BulletSimpleBody();
   BulletSimpleBody(const BulletSimpleBody&) = delete;
