@@ -242,7 +242,8 @@ TEST(CapeAction, EveryConvexShapeBecomesACoreCollider) {
   EXPECT_EQ(action.coreColliders()[0].shape, cape::ColliderShape::ConvexHull);
   EXPECT_EQ(action.coreColliders()[0].hull->vertices.size(), 12u);
   EXPECT_EQ(action.coreColliders()[0].hull->planes.size(), 8u);  // a hexagonal prism
-  EXPECT_FLOAT_EQ(action.coreColliders()[0].thickness, float(makeHull()->getMargin()));
+  EXPECT_FLOAT_EQ(action.coreColliders()[0].thickness,
+                  float(action.activeObjects()[0]->getCollisionShape()->getMargin()));
   EXPECT_EQ(action.coreColliders()[1].shape, cape::ColliderShape::Sphere);
   EXPECT_EQ(action.meshShapeCount(), 0u);
   w.world->removeAction(&action);
