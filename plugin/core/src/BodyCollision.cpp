@@ -61,6 +61,20 @@ struct Sweep {
         margin(margin_) {}
 };
 
+/// Moves particle i from x to its corrected position xn (world). The seed's explicit mode moves positions
+/// only, so there the velocity follows the correction.
+inline void placeParticle(const CollisionArrays& p, Eigen::Index i, const Vec3& x, const Vec3& xn, float invH,
+                          bool explicitMode) {
+  if (explicitMode) {
+    p.vx[i] += (xn.x() - x.x()) * invH;
+    p.vy[i] += (xn.y() - x.y()) * invH;
+    p.vz[i] += (xn.z() - x.z()) * invH;
+  }
+  p.px[i] = xn.x();
+  p.py[i] = xn.y();
+  p.pz[i] = xn.z();
+}
+
 /// Broad phase, vectorised over all particles: the free particles that could reach the collider (a lower
 /// bound of the distance to its shape, or to the plane) within this substep go on to the exact test.
 template <ColliderShape S>
@@ -226,16 +240,7 @@ __attribute__((flatten)) void collideWith(const Collider& c, const CollisionArra
     Vec3 bn, normal;
     if (!resolveSweep<S>(c, margin, a, b, sb, bn, normal)) continue;
     applyFriction(mu, a, b, normal, bn);
-    const Vec3 xn = w.RB * bn + w.B.position;
-    if (explicitMode) {
-      // The seed moves positions only; keep the velocity consistent with the correction.
-      p.vx[i] += (xn.x() - x.x()) * invH;
-      p.vy[i] += (xn.y() - x.y()) * invH;
-      p.vz[i] += (xn.z() - x.z()) * invH;
-    }
-    p.px[i] = xn.x();
-    p.py[i] = xn.y();
-    p.pz[i] = xn.z();
+    placeParticle(p, i, x, w.RB * bn + w.B.position, invH, explicitMode);
     q.contacts->push_back({i, q.collider});
     q.planes->push_back(Eigen::Vector4f::Zero());
   }
@@ -432,15 +437,7 @@ void BodyCollision::collideMesh(const Collider& c, const CollisionArrays& p, std
                      b, bn, normal, plane))
       continue;
     applyFriction(mu, a, b, normal, bn);
-    const Vec3 xn = w.RB * bn + w.B.position;
-    if (explicitMode) {
-      p.vx[i] += (xn.x() - x.x()) * invH;
-      p.vy[i] += (xn.y() - x.y()) * invH;
-      p.vz[i] += (xn.z() - x.z()) * invH;
-    }
-    p.px[i] = xn.x();
-    p.py[i] = xn.y();
-    p.pz[i] = xn.z();
+    placeParticle(p, i, x, w.RB * bn + w.B.position, invH, explicitMode);
     contacts_.push_back({static_cast<std::uint32_t>(i), ci});
     contactPlanes_.push_back(plane);
   }
