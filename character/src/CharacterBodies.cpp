@@ -28,6 +28,18 @@ std::unique_ptr<btCollisionShape> makeShape(const ShapeDesc& s) {
       // btCylinderShapeZ takes half extents (radius, radius, half length) with its axis along local z.
       return std::make_unique<btCylinderShapeZ>(
           btVector3(btScalar(s.radius), btScalar(s.radius), btScalar(s.halfLength)));
+    case ShapeType::Capsule:
+      // btCapsuleShapeZ takes the radius and the distance between the two sphere centres.
+      return std::make_unique<btCapsuleShapeZ>(btScalar(s.radius), btScalar(2.0 * s.halfLength));
+    case ShapeType::ConvexHull: {
+      // The hull's margin is its rounding: Bullet's surface is the hull grown by the margin, as ours.
+      auto hull = std::make_unique<btConvexHullShape>();
+      for (const Eigen::Vector3d& v : s.hull)
+        hull->addPoint(btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z())), false);
+      hull->recalcLocalAabb();
+      hull->setMargin(btScalar(s.radius));
+      return hull;
+    }
   }
   return nullptr;
 }

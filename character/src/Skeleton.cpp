@@ -46,6 +46,8 @@ void Skeleton::rebuildShapes() {
       s.radius *= scale_;
       s.halfLength *= scale_;
       s.halfExtents *= scale_;
+      for (Eigen::Vector3d& v : s.hull) v *= scale_;
+      for (Eigen::Vector4d& plane : s.hullPlanes) plane.w() *= scale_;
       s.origin.translation() *= scale_;
     }
   }

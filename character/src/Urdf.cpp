@@ -52,6 +52,10 @@ const char* toString(ShapeType type) {
       return "box";
     case ShapeType::Cylinder:
       return "cylinder";
+    case ShapeType::Capsule:
+      return "capsule";
+    case ShapeType::ConvexHull:
+      return "convex hull";
   }
   return "unknown";
 }

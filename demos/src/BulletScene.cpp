@@ -32,6 +32,15 @@ Vec3 crowdOffset(int k, int count) {
   return Vec3(2.0f * (static_cast<float>(k) - 0.5f * static_cast<float>(count - 1)), 0.0f, 0.0f);
 }
 
+// The core's hull of a character's convex-hull shape (vertices and planes in the shape frame).
+std::shared_ptr<const ConvexHull> hullOf(const character::ShapeDesc& shape) {
+  std::vector<Vec3> vertices;
+  std::vector<Eigen::Vector4f> planes;
+  for (const Eigen::Vector3d& v : shape.hull) vertices.push_back(v.cast<float>());
+  for (const Eigen::Vector4d& p : shape.hullPlanes) planes.push_back(p.cast<float>());
+  return ConvexHull::make(std::move(vertices), std::move(planes));
+}
+
 }  // namespace
 
 /// One character: its bodies (from the character library, or the simple body's five), and its cape's pins.
@@ -40,6 +49,7 @@ struct BulletScene::Character {
   // URDF character.
   std::unique_ptr<character::Character> urdf;
   int torsoLink = 0;
+  std::vector<std::shared_ptr<const ConvexHull>> hulls;  ///< per Skeleton::worldShapes() entry; null: none
   // The simple body.
   std::unique_ptr<BulletSimpleBody> simple;
 
@@ -154,6 +164,8 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
         return false;
       }
       c->urdf = std::move(made.character);
+      for (const character::WorldShape& w : c->urdf->skeleton().worldShapes())
+        c->hulls.push_back(w.shape->type == character::ShapeType::ConvexHull ? hullOf(*w.shape) : nullptr);
       if (k == 0)
         for (const std::string& w : c->urdf->warnings())
           if (std::find(warnings_.begin(), warnings_.end(), w) == warnings_.end()) warnings_.push_back(w);
@@ -229,7 +241,9 @@ std::vector<Collider> BulletScene::bodyColliders(int k) const {
     return std::vector<Collider>(s.begin(), s.end());
   }
   std::vector<Collider> out;
-  for (const character::WorldShape& w : c.urdf->skeleton().worldShapes()) {
+  const std::vector<character::WorldShape> shapes = c.urdf->skeleton().worldShapes();
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    const character::WorldShape& w = shapes[k];
     const Pose pose = poseOf(w.pose);
     Collider col;
     switch (w.shape->type) {
@@ -242,6 +256,14 @@ std::vector<Collider> BulletScene::bodyColliders(int k) const {
       case character::ShapeType::Cylinder:
         col = Collider::cylinder(static_cast<float>(w.shape->radius), static_cast<float>(w.shape->halfLength),
                                  2, pose);
+        break;
+      case character::ShapeType::Capsule:
+        col = Collider::capsule(static_cast<float>(w.shape->radius), static_cast<float>(w.shape->halfLength),
+                                2, pose);
+        break;
+      case character::ShapeType::ConvexHull:
+        col = Collider::convexHull(c.hulls[k], pose);
+        col.thickness = static_cast<float>(w.shape->radius);  // the hull's rounding
         break;
     }
     col.name = w.shape->name.empty() ? *w.linkName : w.shape->name;

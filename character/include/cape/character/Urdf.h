@@ -18,17 +18,24 @@
 
 namespace cape::character {
 
-/// Collision primitives. URDF (and urdfdom 3.0) has no capsule; mesh elements are not loaded (see
-/// warnings()).
-enum class ShapeType : int { Sphere, Box, Cylinder };
+/// Collision shapes. Capsule is the `<capsule radius length>` extension that Bullet's URDF importer,
+/// PyBullet, Drake and the MuJoCo converters write (urdfdom itself has none). A mesh element becomes a
+/// ConvexHull: the convex hull of the mesh file's vertices, simplified to a vertex budget (UrdfLoadOptions).
+enum class ShapeType : int { Sphere, Box, Cylinder, Capsule, ConvexHull };
 const char* toString(ShapeType type);
 
 /// One collision element of a link, in the link's frame.
 struct ShapeDesc {
   ShapeType type = ShapeType::Sphere;
-  double radius = 0.0;                                    ///< m; sphere and cylinder
-  double halfLength = 0.0;                                ///< m; cylinder, along its local z axis (URDF rule)
+  double radius = 0.0;      ///< m; sphere, cylinder and capsule; for a hull, its rounding (see hull)
+  double halfLength = 0.0;  ///< m; cylinder, and a capsule's cylindrical part, along its local z (URDF rule)
   Eigen::Vector3d halfExtents = Eigen::Vector3d::Zero();  ///< m; box, along its local x, y, z
+  /// ConvexHull: the hull's vertices in the shape frame (m, the element's `scale` applied). The surface is
+  /// the hull grown by `radius`, which covers every mesh vertex the simplification left out.
+  std::vector<Eigen::Vector3d> hull;
+  /// ConvexHull: its outward faces (unit normal n, offset d; inside where n . p <= d), in the shape frame.
+  std::vector<Eigen::Vector4d> hullPlanes;
+  std::string meshFile;  ///< ConvexHull: the mesh file it was made from, as resolved on disk
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< shape frame in the link frame
   std::string name;  ///< the element's name attribute, or "<link>#<k>" when it has none
 };
