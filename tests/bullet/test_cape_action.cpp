@@ -316,6 +316,37 @@ TEST(CapeAction, ExplicitColliderWithoutDiscovery) {
   w.world->removeAction(&action);
 }
 
+// --- Gravity from the world ------------------------------------------------------------------------------
+
+TEST(CapeAction, TakesGravityFromTheWorldEveryStepUnlessTold) {
+  // A free cape in a Z-up world falls along -Z; when the world's gravity turns to +X mid-run, it follows.
+  World w;
+  w.world->setGravity(btVector3(0, 0, btScalar(-9.8)));
+  CapeAction action(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.5)));
+  w.world->addAction(&action);
+  const btVector3 start = action.position(0);
+  for (int frame = 0; frame < 30; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  const btVector3 fell = action.position(0) - start;
+  EXPECT_LT(fell.z(), btScalar(-0.8));                 // 0.5 g t^2 = 1.2 m in 0.5 s, less the air's drag
+  EXPECT_NEAR(fell.y(), btScalar(0), btScalar(1e-4));  // nothing along the settings' -Y
+  EXPECT_EQ(action.cape().settings().gravity, cape::Vec3(0, 0, -9.8f));
+  w.world->setGravity(btVector3(btScalar(9.8), 0, 0));
+  for (int frame = 0; frame < 30; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_GT(action.position(0).x() - start.x(), btScalar(0.5));
+  w.world->removeAction(&action);
+
+  // Off: the settings' gravity (-Y) holds whatever the world says.
+  cape::bullet::CapeActionSettings own;
+  own.useWorldGravity = false;
+  CapeAction fixed(cornerFabric(), cape::CapeSettings(), horizontalAt(btScalar(0.5)), own);
+  w.world->addAction(&fixed);
+  const btVector3 before = fixed.position(0);
+  for (int frame = 0; frame < 30; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_NEAR(fixed.position(0).y() - before.y(), fell.z(), btScalar(1e-4));  // the same fall, along -Y
+  EXPECT_NEAR(fixed.position(0).x() - before.x(), btScalar(0), btScalar(1e-4));
+  w.world->removeAction(&fixed);
+}
+
 // --- Unsupported shapes, removed bodies -----------------------------------------------------------------
 
 namespace {

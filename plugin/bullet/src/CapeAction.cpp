@@ -6,6 +6,8 @@
 //   2. advance (this cape only): Cape::step, which resolves every collider inside its substeps.
 #include "cape/bullet/CapeAction.h"
 
+#include <BulletDynamics/Dynamics/btDynamicsWorld.h>
+
 #include "cape/bullet/Convert.h"
 
 #include <BulletCollision/BroadphaseCollision/btBroadphaseInterface.h>
@@ -464,9 +466,20 @@ void CapeAction::gatherTriangles(const btConcaveShape* shape, const btTransform&
   shape->processAllTriangles(&collect, qlo, qhi);
 }
 
+void CapeAction::followGravity(btCollisionWorld* world) {
+  // Only a dynamics world has a gravity; a bare collision world leaves CapeSettings::gravity in force.
+  const auto* dynamics = dynamic_cast<const btDynamicsWorld*>(world);
+  if (dynamics == nullptr) return;
+  const Vec3 g = toVec3(dynamics->getGravity());
+  if (g == cape_.settings().gravity) return;
+  if (!cape_.setGravity(g).ok())
+    warnOnce("gravity", "the world's gravity is not finite; the cape keeps its own");
+}
+
 void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   if (!ok() || world == nullptr || !(dt > 0)) return;
   const auto start = std::chrono::steady_clock::now();
+  if (settings_.useWorldGravity) followGravity(world);
   dropMissing(world);
   discover(world);
   advancePoses(dt);

@@ -103,6 +103,12 @@ std::uint64_t Cape::selfContactSearches() const {
   return work_ ? work_->self.searches() : 0;
 }
 
+Status Cape::setGravity(const Vec3& gravity) {
+  if (!gravity.allFinite()) return Status::error("Cape::setGravity: gravity must be finite");
+  settings_.gravity = gravity;
+  return Status::success();
+}
+
 Status Cape::setSettings(const CapeSettings& settings) {
   Status s = settings.validate();
   if (!s.ok()) return s;

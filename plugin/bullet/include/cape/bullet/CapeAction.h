@@ -71,6 +71,11 @@ struct CapeActionSettings {
   /// teleports: the whole cape is moved rigidly with it (Cape::teleport) and no collider is swept.
   btScalar teleportDistance = btScalar(1);
   btScalar teleportAngle = btScalar(1.0);
+
+  /// Take gravity from the world the cape steps in (btDynamicsWorld::getGravity(), read before every step),
+  /// so a Z-up world or a changed gravity needs nothing more. Off: CapeSettings::gravity stays in force. A
+  /// world whose gravity is not finite leaves the cape's gravity as it was, with one warning.
+  bool useWorldGravity = true;
 };
 
 /// One particle pinned to a rigid body at a point in the body's frame.
@@ -191,6 +196,7 @@ class CapeAction : public btActionInterface {
 
   Tracked& track(const btCollisionObject* object);
   Tracked* find(const btCollisionObject* object);
+  void followGravity(btCollisionWorld* world);
   void dropMissing(btCollisionWorld* world);
   void discover(btCollisionWorld* world);
   void advancePoses(btScalar dt);

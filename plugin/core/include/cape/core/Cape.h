@@ -49,6 +49,9 @@ class Cape {
   const CapeSettings& settings() const { return settings_; }
   /// Changes the settings; rejected (returning the error, keeping the old settings) if invalid.
   Status setSettings(const CapeSettings& settings);
+  /// Gravity for the next steps (m/s^2, world frame), e.g. the world's, read before every step. Not finite:
+  /// an error, and the gravity stays what it was.
+  Status setGravity(const Vec3& gravity);
   const CapeState& state() const { return state_; }
   /// Direct access for tools and tests; keep inverse masses and pins consistent (use pin()/unpin()).
   CapeState& mutableState() { return state_; }
