@@ -74,10 +74,17 @@ RootPose Gait::rootAt(double t) const {
   return r;
 }
 
-std::array<double, kGaitRoleCount> Gait::anglesAt(double t) const {
+std::array<double, kGaitRoleCount> Gait::standingAngles() const {
   std::array<double, kGaitRoleCount> a{};
+  a[static_cast<std::size_t>(GaitRole::LeftShoulderRoll)] = params_.armOut;
+  a[static_cast<std::size_t>(GaitRole::RightShoulderRoll)] = params_.armOut;
+  return a;
+}
+
+std::array<double, kGaitRoleCount> Gait::anglesAt(double t) const {
+  std::array<double, kGaitRoleCount> a = standingAngles();
   const GaitParams& g = params_;
-  if (!(g.stepFrequency > 0.0)) return a;  // standing: the rest pose
+  if (!(g.stepFrequency > 0.0)) return a;  // standing: the rest pose, arms down
   const double p = 2.0 * kPi * g.stepFrequency * t;
   const double s = std::sin(p), c = std::cos(p);
   auto at = [&](GaitRole role) -> double& { return a[static_cast<std::size_t>(role)]; };
@@ -95,21 +102,30 @@ std::array<double, kGaitRoleCount> Gait::anglesAt(double t) const {
   at(GaitRole::RightShoulder) = g.armSwing * s;
   at(GaitRole::LeftElbow) = g.elbowBase + g.elbowSwing * 0.5 * (1.0 - s);
   at(GaitRole::RightElbow) = g.elbowBase + g.elbowSwing * 0.5 * (1.0 + s);
+  at(GaitRole::LeftShoulderRoll) = g.armOut + g.armOutSwing * s * s;
+  at(GaitRole::RightShoulderRoll) = g.armOut + g.armOutSwing * s * s;
   return a;
+}
+
+void Gait::setJoints(const std::array<double, kGaitRoleCount>& angles, const JointMapping& mapping,
+                     Skeleton& skeleton) {
+  for (int r = 0; r < kGaitRoleCount; ++r) {
+    const JointMapping::Entry& e = mapping.entries()[static_cast<std::size_t>(r)];
+    if (e.joint < 0) continue;
+    const double turn = e.sign * angles[static_cast<std::size_t>(r)];
+    // Exactly sign * angle when the neutral is 0 (0 + x is not x for x = -0), so models without neutral
+    // positions keep their bits.
+    const double q = e.neutral == 0.0 ? turn : e.neutral + turn;
+    // Clamped here, so setJointPosition never reports OutsideLimits for the gait.
+    (void)skeleton.setJointPosition(e.joint, skeleton.clampToLimits(e.joint, q));
+  }
 }
 
 void Gait::apply(double t, const JointMapping& mapping, Skeleton& skeleton,
                  const Eigen::Vector3d& offset) const {
   const RootPose root = rootAt(t);
   skeleton.setRoot(root.origin + offset, root.yaw);
-  const std::array<double, kGaitRoleCount> angles = anglesAt(t);
-  for (int r = 0; r < kGaitRoleCount; ++r) {
-    const JointMapping::Entry& e = mapping.entries()[static_cast<std::size_t>(r)];
-    if (e.joint < 0) continue;
-    // Clamped here, so setJointPosition never reports OutsideLimits for the gait.
-    (void)skeleton.setJointPosition(
-        e.joint, skeleton.clampToLimits(e.joint, e.sign * angles[static_cast<std::size_t>(r)]));
-  }
+  setJoints(anglesAt(t), mapping, skeleton);
 }
 
 }  // namespace cape::character

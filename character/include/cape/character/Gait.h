@@ -15,9 +15,13 @@
 //   ankle     a (knee - hip): a = 1 keeps the foot level, a < 1 lets it follow the shin a little
 //   shoulder  left  -S sin p                       right  S sin p    (arms swing against the legs)
 //   elbow     left  E0 + E1 (1 - sin p) / 2        right  E0 + E1 (1 + sin p) / 2 (more bent when forward)
-// then joint position = sign * angle, clamped to the joint's limits. Every angle is a function of p alone, so
-// the joint trajectories repeat every 1/f seconds (and the bob too when its frequency is a multiple of f).
-// With f = 0 (standing) every angle is 0: the rest pose.
+//   shoulder roll  both  O + Os sin^2 p           (arms held a little away from the body, a little further
+//                                                  out at each end of their swing)
+// then joint position = neutral + sign * angle, clamped to the joint's limits (see JointMapping.h: the
+// neutral is 0, but the shoulder roll's, which hangs the arm down; when the neutral is 0 the position is
+// exactly sign * angle). Every angle is a function of p alone, so the joint trajectories repeat every 1/f
+// seconds (and the bob too when its frequency is a multiple of f). With f = 0 (standing) every angle is 0
+// but the shoulder roll's O: the standing pose (standingAngles), the rest pose with the arms down.
 #pragma once
 
 #include "cape/character/JointMapping.h"
@@ -43,6 +47,8 @@ struct GaitParams {
   double armSwing = 0.35;        ///< rad, S
   double elbowBase = 0.5;        ///< rad, E0
   double elbowSwing = 0.2;       ///< rad, E1
+  double armOut = 0.12;          ///< rad, O: the shoulder roll's hold away from the body (hands clear thighs)
+  double armOutSwing = 0.05;     ///< rad, Os
 
   /// Amplitudes that look right at a speed: knees and elbows bend more, arms swing wider as it speeds up
   /// (walk at 1.4 m/s: K 0.81, S 0.36, E0 0.53; sprint at 5 m/s: K 1.35, S 0.65, E0 1.25). Bob 1.5 cm at
@@ -77,6 +83,12 @@ class Gait {
   RootPose rootAt(double t) const;
   /// Anatomical angles of every role at time t (rad), indexed by GaitRole.
   std::array<double, kGaitRoleCount> anglesAt(double t) const;
+  /// The angles with every swing at 0: all 0 but the shoulder rolls' armOut. What the gait stands in.
+  std::array<double, kGaitRoleCount> standingAngles() const;
+  /// Sets every mapped joint from anatomical angles: neutral + sign * angle, clamped to the joint's limits
+  /// (apply's joint half). Unmapped joints and joints of no role are left where they are. No allocation.
+  static void setJoints(const std::array<double, kGaitRoleCount>& angles, const JointMapping& mapping,
+                        Skeleton& skeleton);
   /// Poses `skeleton` at time t: the root (bob included, `offset` added: m, in the world, for characters side
   /// by side) and every mapped joint; unmapped joints and joints of no role are left where they are. No
   /// allocation.

@@ -2,11 +2,21 @@
 //
 // The gait speaks in anatomical angles, the same for every model: a positive hip or shoulder angle swings the
 // limb forward, a positive knee angle bends the knee (shin backwards), a positive elbow angle bends the elbow
-// (forearm forwards), a positive ankle angle lifts the toes. A URDF may turn its joints either way, so each
-// role carries a sign, found from the model itself: with the joint turned a little either side of rest, do
-// the links beyond it move forward or backward (URDF +x, seen in the root link's frame)? Hip, ankle, shoulder
-// and elbow want "forward", the knee "backward". A joint that moves its links neither way (its axis is not
-// side to side) cannot be signed and is left unmapped, with a warning.
+// (forearm forwards), a positive ankle angle lifts the toes, a positive shoulder roll angle lifts the arm
+// sideways, away from the body. A URDF may turn its joints either way, so each role carries a sign, found
+// from the model itself: with the joint turned a little either side of rest, do the links beyond it move
+// forward or backward (URDF +x, seen in the root link's frame)? Hip, ankle, shoulder and elbow want
+// "forward", the knee "backward". A joint that moves its links neither way (its axis is not side to side)
+// cannot be signed: byCommonNames leaves it unmapped, and any mapping warns.
+//
+// Arms down. Each role also has a neutral joint position, where its anatomical angle is 0: 0 for every role
+// but the shoulder roll (abduction), whose neutral is the angle that brings the arm (the direction from the
+// roll joint to the farthest link origin or shape centre beyond it: the hand) as close as forward kinematics
+// allows to hanging straight down, from the rest pose. Its sign is the way that lifts the arm away from the
+// body there. So a model built in a T-pose or an A-pose walks with its arms at its sides. The other roles'
+// signs are found in that arms-down pose (in a T-pose the arm lies along the shoulder's pitch axis, and only
+// once it hangs down does a pitch joint swing it forward); a ball shoulder made of three revolute joints in
+// any order works the same way: whichever of them swings the hanging arm forward is the shoulder.
 #pragma once
 
 #include "cape/character/Urdf.h"
@@ -28,36 +38,55 @@ enum class GaitRole : int {
   RightShoulder,
   LeftElbow,
   RightElbow,
+  LeftShoulderRoll,  ///< shoulder abduction: the arm up and down sideways (optional: no warning if absent)
+  RightShoulderRoll,
 };
-constexpr int kGaitRoleCount = 10;
+constexpr int kGaitRoleCount = 12;
 const char* toString(GaitRole role);
 
 class JointMapping {
  public:
   struct Entry {
     int joint = -1;     ///< index into UrdfModel::joints(); -1 = unmapped (that joint stays at rest)
-    double sign = 1.0;  ///< joint position = sign * anatomical angle (then clamped to the joint's limits)
+    double sign = 1.0;  ///< joint position = neutral + sign * anatomical angle, clamped to the limits
+    /// Joint position (rad or m) where the anatomical angle is 0: 0, but for a shoulder roll the angle that
+    /// hangs the arm down (see above).
+    double neutral = 0.0;
   };
 
   /// Explicit joint names per role (an empty name leaves the role unmapped). A name that is not a movable
   /// joint of the model leaves the role unmapped and adds a warning. Signs are found as described above.
   static JointMapping fromNames(const UrdfModelPtr& model,
                                 const std::array<std::string, kGaitRoleCount>& names);
-  /// The joint names of the shipped humanoid (character/models/humanoid.urdf).
+  /// The joint names of the shipped humanoid (character/models/humanoid.urdf); it has no shoulder roll
+  /// joints, so those two names are empty.
   static std::array<std::string, kGaitRoleCount> shippedHumanoidNames();
   /// Recognises common names: a part (hip, knee, ankle, shoulder, elbow) and a side ("left"/"right", an "l_"
   /// or "r_" prefix, an "_l" or "_r" suffix, or "l"/"r" right before the part, as in "lknee"),
-  /// case-insensitive; only revolute and continuous joints. Where a part has several joints on one side (hip
-  /// roll, pitch, yaw), the one turning most nearly about the side-to-side axis is taken.
+  /// case-insensitive; only revolute and continuous joints ("arm_sh" counts as a shoulder, as in l_arm_shx).
+  /// Shoulder rolls first: in each side's shoulder chain (its shoulder-named joints, and the joints between
+  /// the first of them and the elbow), the joint whose axis is most nearly the forward axis (URDF x, at least
+  /// cos 45 degrees), a name saying so (roll, abduct, adduct, shx, "_x") preferred; it lowers the arm (see
+  /// above). Then, in that arms-down pose, where a part has several joints on one side (hip roll, pitch,
+  /// yaw), the one turning most nearly about the side-to-side axis is taken (on a tie, one named pitch, flex,
+  /// shy or "_y"; then the first).
   static JointMapping byCommonNames(const UrdfModelPtr& model);
-  /// The shipped humanoid's names when the model has them all, common names otherwise.
+  /// The shipped humanoid's names when the model has them all (and shoulder rolls found as byCommonNames
+  /// finds them), common names otherwise.
   static JointMapping automatic(const UrdfModelPtr& model);
 
   const Entry& operator[](GaitRole role) const { return entries_[static_cast<std::size_t>(role)]; }
   const std::array<Entry, kGaitRoleCount>& entries() const { return entries_; }
+  /// Changes a role's neutral position (rad or m).
+  void setNeutral(GaitRole role, double q) { entries_[static_cast<std::size_t>(role)].neutral = q; }
+  /// Shoulder rolls: optional roles, said nothing of when absent.
+  static bool isShoulderRoll(GaitRole role) {
+    return role == GaitRole::LeftShoulderRoll || role == GaitRole::RightShoulderRoll;
+  }
   /// Roles with no joint; those joints stay at rest.
   std::vector<GaitRole> unmappedRoles() const;
-  /// What the caller may want to print: unmapped roles, names not found, joints that could not be signed.
+  /// What the caller may want to print: unmapped roles, names not found, joints that could not be signed,
+  /// arms that cannot be brought down.
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
