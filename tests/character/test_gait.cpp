@@ -253,6 +253,7 @@ TEST(Gait, TPoseAndAPoseArmsWalkHangingDown) {
       EXPECT_EQ(m[GaitRole::LeftShoulderRoll].joint, r.model->findJoint("left_shoulder_roll"));
       EXPECT_EQ(m[GaitRole::RightShoulderRoll].joint, r.model->findJoint("right_shoulder_roll"));
       EXPECT_EQ(m[GaitRole::LeftShoulder].joint, r.model->findJoint("left_shoulder_pitch"));
+      EXPECT_NEAR(c.rootHeight(), 0.93, 1e-6);
       const std::string what = std::string(cape::toString(scene)) + " spread " + std::to_string(spread);
       double lowestDrop = 1.0, leastOut = 1.0, widestSwing = 0.0;
       for (int k = 0; k <= 2 * 240; ++k) {  // two walk cycles, five sprint cycles, at 1/240 s

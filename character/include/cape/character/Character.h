@@ -7,11 +7,17 @@
 //                                                  cape::character::Gait::forScene(cape::SceneKind::Walk));
 //   for (const std::string& w : made.character->warnings()) print(w);
 //   btRigidBody* leftShoulder = made.character->bodies().bodyForLink("left_shoulder");
+//   std::printf("root %.3f m above the ground\n", made.character->rootHeight());
 //   for (int frame = 1; frame <= 600; ++frame) {
-//     made.character->advanceTo(frame / 60.0);        // poses the skeleton, moves the bodies (velocities
-//     too) world.stepSimulation(1 / 60.f, 8, 1 / 240.f); made.character->skeleton().worldShapes(shapes);  //
-//     colliders to export: link, type, sizes, world pose
+//     made.character->advanceTo(frame / 60.0);  // poses the skeleton, moves the bodies (velocities too)
+//     world.stepSimulation(1 / 60.f, 8, 1 / 240.f);
+//     made.character->skeleton().worldShapes(shapes);  // colliders to export: link, type, sizes, world pose
 //   }
+//
+// It stands on the ground: its root goes where the lowest collision point of its standing pose touches
+// world y = 0 (Grounding.h), or at CharacterSettings::rootHeight. A floating base (a root at the pelvis, a
+// floating joint, a dummy "world" link) is said in warnings(). CharacterSettings::pose gives it a starting
+// pose; parsePose reads one from text.
 #pragma once
 
 #include "cape/character/CharacterBodies.h"
@@ -20,16 +26,36 @@
 #include "cape/character/Skeleton.h"
 
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cape::character {
+
+/// A starting joint configuration: (joint name, position in rad, or m for a prismatic joint) pairs.
+using JointPose = std::vector<std::pair<std::string, double>>;
 
 struct CharacterSettings {
   double scale = 1.0;                                ///< uniform scale of the URDF, > 0
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();  ///< m, world, added to the gait's root path (a crowd)
   BodySettings bodies;                               ///< collision group, mask, ...
+  /// m: the height of the URDF root link origin above the ground (world y = 0; the offset and the gait's bob
+  /// come on top). Unset: automatic, so that the lowest collision point of the standing pose (the gait's
+  /// standingAngles with `pose` applied) touches the ground; a root already on the ground stays at exactly 0.
+  std::optional<double> rootHeight;
+  /// The starting pose, the base of every frame: a joint the gait does not drive keeps its value; a joint it
+  /// drives gets the gait's angle added to it (its mapping neutral; for a shoulder roll the value replaces
+  /// the arms-down neutral). Names must be movable joints of the model (each once); values outside the
+  /// limits are clamped, with a warning.
+  JointPose pose;
 };
+
+/// Parses the demos' `--pose` text: `name=value[,name=value...]` (rad, or m for a prismatic joint; spaces
+/// around names and values allowed; an empty text is an empty pose). InvalidArgument, saying which entry and
+/// why, for an entry without '=', an empty name, a value that is not a number or not finite, or a name given
+/// twice; `out` is then left empty.
+Status parsePose(const std::string& text, JointPose& out);
 
 class Character;
 struct CharacterResult {
@@ -40,8 +66,11 @@ struct CharacterResult {
 
 class Character {
  public:
-  /// Builds the skeleton (joints mapped with JointMapping::automatic, unless `mapping` is given), poses it at
-  /// t = 0 and adds its bodies to `world` at rest. Errors: InvalidArgument (null model, bad scale).
+  /// Builds the skeleton (joints mapped with JointMapping::automatic, unless `mapping` is given), applies the
+  /// settings' pose, places the root on the ground (see CharacterSettings::rootHeight), poses it at t = 0 and
+  /// adds its bodies to `world` at rest. Errors: InvalidArgument (null model, bad scale, a non-finite root
+  /// height or pose value, a joint named twice); UnknownJoint and NotMovable for a pose naming no joint or a
+  /// fixed one (the message lists the model's movable joints).
   static CharacterResult create(const UrdfModelPtr& model, btDynamicsWorld& world, const Gait& gait,
                                 const CharacterSettings& settings = {},
                                 const JointMapping* mapping = nullptr);
@@ -60,18 +89,28 @@ class Character {
   const Gait& gait() const { return gait_; }
   const JointMapping& mapping() const { return mapping_; }
   const CharacterSettings& settings() const { return settings_; }
-  /// The model's load warnings followed by the mapping's (unmapped roles and why).
+  /// m: the height of the URDF root link origin above the ground that was chosen (CharacterSettings::
+  /// rootHeight, or the automatic one); the gait's bob and the offset come on top.
+  double rootHeight() const { return rootHeight_; }
+  /// The model's load warnings, then the mapping's (unmapped roles and why), then the character's own (pose
+  /// values clamped, a floating base and how it was placed, no collision shapes).
   std::vector<std::string> warnings() const;
 
  private:
   Character(const UrdfModelPtr& model, const Gait& gait, const CharacterSettings& settings,
             JointMapping mapping);
+  Status applyPose();  // the settings' pose: checked, clamped, into the skeleton and the mapping's neutrals
+  void placeOnTheGround();
   Skeleton skeleton_;
   Gait gait_;
   CharacterSettings settings_;
   JointMapping mapping_;
   std::unique_ptr<CharacterBodies> bodies_;  ///< made after the skeleton is posed; reads skeleton_
   double time_ = 0.0;
+  double rootHeight_ = 0.0;
+  Eigen::Vector3d rootOffset_ = Eigen::Vector3d::Zero();  ///< settings' offset, raised by the root height
+  std::vector<std::pair<int, double>> pose_;              ///< joint index, clamped value
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace cape::character

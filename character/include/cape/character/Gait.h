@@ -6,7 +6,8 @@
 // cape::motionAt(MotionDesc, t) (docs/SCENES.md: walk at 1.4 m/s, sprint-turn at 5 m/s with a 180 degree
 // turn in the last 0.5 s of every 2 s), with the torso bob added to the root height, as the simple body does.
 // A gait with a constant turn rate w follows the exact arc: yaw = w t, and with forward = (-sin yaw, 0, -cos
-// yaw), position = (v/w (cos w t - 1), 0, -v/w sin w t).
+// yaw), position = (v/w (cos w t - 1), 0, -v/w sin w t). (Character lifts this path by its root height, so
+// that a model whose root is not on the ground stands on it.)
 //
 // Joint angles, anatomical (see JointMapping.h), with phase p = 2 pi f t:
 //   hip       left  A sin p                        right  -A sin p   (docs/SCENES.md: A = 0.5236 rad)
@@ -83,7 +84,8 @@ class Gait {
   RootPose rootAt(double t) const;
   /// Anatomical angles of every role at time t (rad), indexed by GaitRole.
   std::array<double, kGaitRoleCount> anglesAt(double t) const;
-  /// The angles with every swing at 0: all 0 but the shoulder rolls' armOut. What the gait stands in.
+  /// The angles with every swing at 0: all 0 but the shoulder rolls' armOut. What the gait stands in, and
+  /// what Character puts on the ground.
   std::array<double, kGaitRoleCount> standingAngles() const;
   /// Sets every mapped joint from anatomical angles: neutral + sign * angle, clamped to the joint's limits
   /// (apply's joint half). Unmapped joints and joints of no role are left where they are. No allocation.

@@ -50,7 +50,7 @@ class JointMapping {
     int joint = -1;     ///< index into UrdfModel::joints(); -1 = unmapped (that joint stays at rest)
     double sign = 1.0;  ///< joint position = neutral + sign * anatomical angle, clamped to the limits
     /// Joint position (rad or m) where the anatomical angle is 0: 0, but for a shoulder roll the angle that
-    /// hangs the arm down (see above).
+    /// hangs the arm down (see above); Character puts the user's pose here (CharacterSettings::pose).
     double neutral = 0.0;
   };
 
@@ -77,7 +77,7 @@ class JointMapping {
 
   const Entry& operator[](GaitRole role) const { return entries_[static_cast<std::size_t>(role)]; }
   const std::array<Entry, kGaitRoleCount>& entries() const { return entries_; }
-  /// Changes a role's neutral position (rad or m).
+  /// Changes a role's neutral position (rad or m): Character puts the user's starting pose there.
   void setNeutral(GaitRole role, double q) { entries_[static_cast<std::size_t>(role)].neutral = q; }
   /// Shoulder rolls: optional roles, said nothing of when absent.
   static bool isShoulderRoll(GaitRole role) {

@@ -1,0 +1,118 @@
+// Lowest collision points per shape type, and the root height that stands a character on the ground.
+#include "cape/character/Grounding.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+namespace cape::character {
+
+namespace {
+
+constexpr double kFloatingBase =
+    0.3;  // m: a root origin this far above the lowest point is not on the ground
+constexpr double kOnTheGround = 1e-6;  // m: a lift smaller than this is none (the bits stay)
+
+std::string metres(double m) {
+  std::ostringstream out;
+  out << std::setprecision(3) << m << " m";
+  return out.str();
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+}  // namespace
+
+double lowestPointY(const ShapeDesc& shape, const Eigen::Isometry3d& pose) {
+  const Eigen::Vector3d& c = pose.translation();
+  const Eigen::Matrix3d& r = pose.linear();
+  switch (shape.type) {
+    case ShapeType::Sphere:
+      return c.y() - shape.radius;
+    case ShapeType::Box:
+      // The corner with every local axis taken the way that goes down.
+      return c.y() - std::abs(r(1, 0)) * shape.halfExtents.x() - std::abs(r(1, 1)) * shape.halfExtents.y() -
+             std::abs(r(1, 2)) * shape.halfExtents.z();
+    case ShapeType::Cylinder: {
+      const double ay = r(1, 2);  // the axis (local z) in the world, its y
+      return c.y() - shape.halfLength * std::abs(ay) - shape.radius * std::sqrt(std::max(0.0, 1.0 - ay * ay));
+    }
+    case ShapeType::Capsule:
+      return c.y() - shape.halfLength * std::abs(r(1, 2)) - shape.radius;
+    case ShapeType::ConvexHull: {
+      double lowest = std::numeric_limits<double>::infinity();
+      for (const Eigen::Vector3d& v : shape.hull) lowest = std::min(lowest, (pose * v).y());
+      return lowest - shape.radius;
+    }
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+std::optional<double> lowestCollisionPoint(const Skeleton& skeleton) {
+  std::optional<double> lowest;
+  for (const WorldShape& w : skeleton.worldShapes()) {
+    const double y = lowestPointY(*w.shape, w.pose);
+    if (std::isfinite(y) && (!lowest || y < *lowest)) lowest = y;
+  }
+  return lowest;
+}
+
+GroundPlacement placeOnGround(const Skeleton& standing, const std::optional<double>& rootHeight) {
+  GroundPlacement p;
+  const UrdfModel& model = standing.model();
+  const LinkDesc& root = model.links()[static_cast<std::size_t>(model.rootLink())];
+  const std::optional<double> lowest = lowestCollisionPoint(standing);
+  const std::string given =
+      rootHeight ? "the root is placed at the given root height " + metres(*rootHeight) : std::string();
+  if (!lowest) {
+    p.rootHeight = rootHeight.value_or(0.0);
+    p.warnings.push_back("no link of '" + model.name() + "' has a collision shape, so nothing can stand on " +
+                         "the ground: " +
+                         (rootHeight ? given
+                                     : "the root link origin stays at height 0 (set "
+                                       "CharacterSettings::rootHeight to place it)"));
+    return p;
+  }
+  const double above = standing.rootTransform().translation().y() - *lowest;
+  p.rootAboveLowest = above;
+  const double lift = std::abs(above) < kOnTheGround ? 0.0 : above;
+  p.rootHeight = rootHeight.value_or(lift);
+
+  // A floating base, said with what was done about it.
+  std::vector<std::string> reasons;
+  if (above > kFloatingBase) {
+    reasons.push_back("root link '" + root.name + "' is " + metres(above) +
+                      " above the lowest collision point (a floating base)");
+  }
+  for (int j : root.childJoints) {
+    const JointDesc& joint = model.joints()[static_cast<std::size_t>(j)];
+    const std::string& child = model.links()[static_cast<std::size_t>(joint.childLink)].name;
+    const bool dummy = lower(root.name) == "world" && root.shapes.empty();
+    const std::string link = dummy ? "root link '" + root.name + "' is a dummy world link, and its "
+                                   : "the root link '" + root.name + "'s ";
+    if (joint.type == JointType::Floating) {
+      reasons.push_back(link + "joint '" + joint.name + "' to '" + child +
+                        "' is floating (a floating base; it is held at its origin)");
+    } else if (joint.type == JointType::Fixed && dummy) {
+      reasons.push_back(link + "joint '" + joint.name + "' to '" + child + "' is fixed (a floating base)");
+    }
+  }
+  std::string done = given;
+  if (!rootHeight) {
+    done = p.rootHeight > 0.0 ? "the character is raised " + metres(p.rootHeight) + " to stand on the ground"
+           : p.rootHeight < 0.0
+               ? "the character is lowered " + metres(-p.rootHeight) + " to stand on the ground"
+               : "it stands on the ground as it is";
+  }
+  for (const std::string& r : reasons) p.warnings.push_back(r + ": " + done);
+  return p;
+}
+
+}  // namespace cape::character
