@@ -94,7 +94,9 @@ CharacterResult Character::create(const UrdfModelPtr& model, btDynamicsWorld& wo
 
 Character::Character(const UrdfModelPtr& model, const Gait& gait, const CharacterSettings& settings,
                      JointMapping mapping)
-    : skeleton_(model), gait_(gait), settings_(settings), mapping_(std::move(mapping)) {}
+    : skeleton_(model), gait_(gait), settings_(settings), mapping_(std::move(mapping)) {
+  skeleton_.setUpAxis(settings.up);  // grounding and the gait work in the Y-up scene frame regardless
+}
 
 Status Character::applyPose() {
   const UrdfModel& model = skeleton_.model();

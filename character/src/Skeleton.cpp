@@ -17,6 +17,19 @@ Eigen::Matrix3d Skeleton::urdfToWorld() {
   return m;
 }
 
+const char* toString(UpAxis up) {
+  return up == UpAxis::Z ? "z" : "y";
+}
+
+Eigen::Matrix3d Skeleton::sceneToWorld(UpAxis up) {
+  return up == UpAxis::Z ? Eigen::Matrix3d(urdfToWorld().transpose()) : Eigen::Matrix3d::Identity();
+}
+
+void Skeleton::setUpAxis(UpAxis up) {
+  up_ = up;
+  dirty_ = true;
+}
+
 Skeleton::Skeleton(UrdfModelPtr model) : model_(std::move(model)) {
   assert(model_ && "Skeleton needs a loaded UrdfModel");
   q_.assign(model_->joints().size(), 0.0);
@@ -127,6 +140,11 @@ void Skeleton::updatePoses() const {
   const auto& joints = model_->joints();
   Eigen::Isometry3d base = root_;
   base.linear() = root_.linear() * urdfToWorld();
+  if (up_ != UpAxis::Y) {
+    const Eigen::Matrix3d w = sceneToWorld(up_);
+    base.linear() = w * base.linear();
+    base.translation() = w * base.translation();
+  }
   poses_[0] = base;
   for (std::size_t l = 1; l < links.size(); ++l) {
     const JointDesc& j = joints[static_cast<std::size_t>(links[l].parentJoint)];

@@ -1,6 +1,7 @@
 // Loading a URDF with urdfdom into the plain data of Urdf.h, with every failure turned into a Status.
 #include "cape/character/Urdf.h"
 
+#include "UrdfGeometry.h"
 #include "XmlOutline.h"
 
 #include <console_bridge/console.h>
@@ -190,6 +191,7 @@ void release(urdf::ModelInterfaceSharedPtr& model) {
 // Builds a UrdfModel from urdfdom's model; a friend of UrdfModel.
 struct UrdfModelBuilder {
   static Status build(const urdf::ModelInterface& in, std::vector<std::string> warnings,
+                      std::unordered_map<std::string, LinkGeometry>& geometry,
                       std::shared_ptr<UrdfModel>& out) {
     auto model = std::make_shared<UrdfModel>();
     model->name_ = in.name_;
@@ -222,9 +224,12 @@ struct UrdfModelBuilder {
       const urdf::Link& src = *order[k];
       LinkDesc& link = model->links_[k];
       link.name = src.name;
-      if (src.inertial) link.mass = src.inertial->mass;
-      Status s = readShapes(src, link, model->warnings_);
-      if (!s.ok()) return s;
+      // Shapes and mass as we read them from the XML (UrdfGeometry.h), not urdfdom's.
+      const auto g = geometry.find(src.name);
+      if (g != geometry.end()) {
+        link.mass = g->second.mass;
+        link.shapes = std::move(g->second.shapes);
+      }
     }
 
     for (std::size_t k = 1; k < order.size(); ++k) {
@@ -298,80 +303,39 @@ struct UrdfModelBuilder {
     }
     return Status::success();
   }
-
-  static Status readShapes(const urdf::Link& src, LinkDesc& link, std::vector<std::string>& warnings) {
-    // collision_array holds every <collision>; older files may fill only `collision`.
-    std::vector<urdf::CollisionSharedPtr> elements = src.collision_array;
-    if (elements.empty() && src.collision) elements.push_back(src.collision);
-    for (std::size_t e = 0; e < elements.size(); ++e) {
-      const urdf::Collision& c = *elements[e];
-      const std::string label = c.name.empty() ? src.name + "#" + std::to_string(e) : c.name;
-      if (!c.geometry) {
-        warnings.push_back("link '" + src.name + "': collision element " + std::to_string(e) +
-                           " has no geometry; skipped");
-        continue;
-      }
-      ShapeDesc shape;
-      shape.name = label;
-      shape.origin = toIsometry(c.origin);
-      switch (c.geometry->type) {
-        case urdf::Geometry::SPHERE: {
-          const auto& g = static_cast<const urdf::Sphere&>(*c.geometry);
-          shape.type = ShapeType::Sphere;
-          shape.radius = g.radius;
-          break;
-        }
-        case urdf::Geometry::BOX: {
-          const auto& g = static_cast<const urdf::Box&>(*c.geometry);
-          shape.type = ShapeType::Box;
-          shape.halfExtents = 0.5 * Eigen::Vector3d(g.dim.x, g.dim.y, g.dim.z);
-          break;
-        }
-        case urdf::Geometry::CYLINDER: {
-          const auto& g = static_cast<const urdf::Cylinder&>(*c.geometry);
-          shape.type = ShapeType::Cylinder;
-          shape.radius = g.radius;
-          shape.halfLength = 0.5 * g.length;
-          break;
-        }
-        case urdf::Geometry::MESH: {
-          // We load no mesh files: the element is skipped, and the caller is told which link lost it.
-          const auto& g = static_cast<const urdf::Mesh&>(*c.geometry);
-          warnings.push_back("link '" + src.name + "': collision element '" + label + "' is a mesh ('" +
-                             g.filename + "'); meshes are not supported, the element is skipped");
-          continue;
-        }
-        default:
-          warnings.push_back("link '" + src.name + "': collision element '" + label +
-                             "' has an unsupported geometry; skipped");
-          continue;
-      }
-      const bool finite = std::isfinite(shape.radius) && std::isfinite(shape.halfLength) &&
-                          shape.halfExtents.allFinite() && shape.origin.matrix().allFinite();
-      const bool positive =
-          (shape.type == ShapeType::Box)
-              ? (shape.halfExtents.array() > 0.0).all()
-              : shape.radius > 0.0 && (shape.type != ShapeType::Cylinder || shape.halfLength > 0.0);
-      if (!finite || !positive) {
-        return Status::error(ErrorCode::InvalidModel, "link '" + src.name + "': collision element '" + label +
-                                                          "' has a non-positive or non-finite size");
-      }
-      link.shapes.push_back(std::move(shape));
-    }
-    return Status::success();
-  }
 };
 
-UrdfLoadResult UrdfModel::fromString(const std::string& xml) {
+UrdfLoadResult UrdfModel::fromString(const std::string& xmlIn, const UrdfLoadOptions& options) {
   UrdfLoadResult result;
+  std::vector<std::string>& warnings = result.warnings;
+  const auto fail = [&](ErrorCode code, const std::string& message) {
+    result.status = Status::error(code, message);
+    return result;
+  };
+  // The text ends at its first NUL, as for Bullet's importer (it reads a C string).
+  const std::size_t nul = xmlIn.find('\0');
+  const std::string xml = nul == std::string::npos ? xmlIn : xmlIn.substr(0, nul);
+  if (nul != std::string::npos &&
+      xmlIn.find_first_not_of(std::string(" \t\r\n\0", 5), nul) != std::string::npos) {
+    warnings.push_back("the text ends at a NUL byte; the " + std::to_string(xmlIn.size() - nul) +
+                       " bytes from there on are ignored");
+  }
   std::string xmlError;
   std::vector<XmlElement> outline;
   if (!scanXml(xml, xmlError, &outline)) {
-    result.status = Status::error(ErrorCode::MalformedXml, "URDF is not well-formed XML: " + xmlError);
-    return result;
+    return fail(ErrorCode::MalformedXml, "URDF is not well-formed XML: " + xmlError);
   }
   result.status = checkJointGraph(outline);
   if (!result.status.ok()) return result;
+
+  UrdfLoadOptions resolved = options;
+  if (resolved.baseDir.empty()) resolved.baseDir = ".";
+  if (resolved.maxHullVertices < 4) {
+    return fail(ErrorCode::InvalidArgument, "maxHullVertices is " + std::to_string(options.maxHullVertices) +
+                                                "; a hull needs at least 4");
+  }
+  std::unordered_map<std::string, LinkGeometry> geometry = readLinkGeometry(outline, resolved, warnings);
+  const std::string clean = textForUrdfdom(xml, outline, warnings);
 
   CapturedConsole console;
   urdf::ModelInterfaceSharedPtr parsed;
@@ -381,7 +345,7 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xml) {
     std::lock_guard<std::mutex> lock(parseMutex());
     console_bridge::useOutputHandler(&console);
     try {
-      parsed = urdf::parseURDF(xml);
+      parsed = urdf::parseURDF(clean);
     } catch (const std::exception& e) {
       threw = true;
       thrown = e.what();
@@ -401,29 +365,29 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xml) {
     } else if (contains(what, "root link")) {
       code = ErrorCode::NotATree;  // "No root link found" (a cycle) or "Two root links found"
     }
-    result.status =
-        Status::error(code, "URDF rejected by urdfdom: " + (what.empty() ? "no reason given" : what));
-    return result;
+    return fail(code, "URDF rejected by urdfdom: " + (what.empty() ? "no reason given" : what));
   }
 
-  // urdfdom may skip what it cannot read (an unknown geometry, say) and still return a model: keep its words.
-  std::vector<std::string> warnings;
+  // urdfdom may skip what it cannot read and still return a model: keep its words.
   for (const std::string& e : console.errors) warnings.push_back("urdfdom: " + e);
   for (const std::string& w : console.warnings) warnings.push_back("urdfdom: " + w);
 
   std::shared_ptr<UrdfModel> model;
   try {
-    result.status = UrdfModelBuilder::build(*parsed, std::move(warnings), model);
+    result.status = UrdfModelBuilder::build(*parsed, warnings, geometry, model);
   } catch (const std::exception& e) {
     result.status =
         Status::error(ErrorCode::InvalidModel, std::string("URDF could not be read: ") + e.what());
   }
   release(parsed);
-  if (result.status.ok()) result.model = std::move(model);
+  if (result.status.ok()) {
+    result.model = std::move(model);
+    result.warnings = result.model->warnings();
+  }
   return result;
 }
 
-UrdfLoadResult UrdfModel::fromFile(const std::string& path) {
+UrdfLoadResult UrdfModel::fromFile(const std::string& path, const UrdfLoadOptions& options) {
   UrdfLoadResult result;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -437,7 +401,12 @@ UrdfLoadResult UrdfModel::fromFile(const std::string& path) {
     result.status = Status::error(ErrorCode::FileNotFound, "URDF file '" + path + "' cannot be read");
     return result;
   }
-  result = fromString(text.str());
+  UrdfLoadOptions withBase = options;
+  if (withBase.baseDir.empty()) {
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    withBase.baseDir = folder.empty() ? std::string(".") : folder.string();
+  }
+  result = fromString(text.str(), withBase);
   if (!result.status.ok()) {
     result.status = Status::error(result.status.code(), path + ": " + result.status.message());
   }

@@ -49,8 +49,10 @@ class XmlScanner {
           return fail(message, "end tag </" + name + "> does not match <" + stack_.back() + ">");
         }
         stack_.pop_back();
+        if (outline_ && open_.back() >= 0) (*outline_)[static_cast<std::size_t>(open_.back())].end = i_;
         open_.pop_back();
       } else {
+        const std::size_t begin = i_;
         advance(1);
         const std::string name = readName();
         if (name.empty()) return fail(message, "'<' not followed by a tag name");
@@ -59,8 +61,13 @@ class XmlScanner {
         XmlElement element;
         element.name = name;
         element.parent = open_.empty() ? -1 : open_.back();
+        element.begin = begin;
+        if (stack_.size() >= kMaxXmlDepth) {
+          return fail(message, "elements nested deeper than " + std::to_string(kMaxXmlDepth) + " levels");
+        }
         bool selfClosing = false;
-        if (!readAttributes(selfClosing, element.attributes, message)) return false;
+        if (!readAttributes(selfClosing, element, message)) return false;
+        if (selfClosing) element.end = i_;
         const int index = outline_ ? static_cast<int>(outline_->size()) : -1;
         if (outline_) outline_->push_back(std::move(element));
         if (!selfClosing) {
@@ -124,8 +131,8 @@ class XmlScanner {
     while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) advance(1);
   }
 
-  bool readAttributes(bool& selfClosing, std::vector<std::pair<std::string, std::string>>& attributes,
-                      std::string& message) {
+  bool readAttributes(bool& selfClosing, XmlElement& element, std::string& message) {
+    std::vector<std::pair<std::string, std::string>>& attributes = element.attributes;
     for (;;) {
       const std::size_t before = i_;
       skipSpace();
@@ -164,6 +171,7 @@ class XmlScanner {
       }
       if (i_ >= s_.size()) return fail(message, "unterminated value of attribute '" + attr + "'");
       attributes.emplace_back(attr, s_.substr(valueStart, i_ - valueStart));
+      element.valueOffsets.push_back(valueStart);
       advance(1);
     }
   }

@@ -12,8 +12,15 @@ struct XmlElement {
   std::string name;
   int parent = -1;  ///< index of the enclosing element in the outline, -1 for the root
   std::vector<std::pair<std::string, std::string>> attributes;  ///< values as written (entities not expanded)
+  std::vector<std::size_t> valueOffsets;  ///< byte offset in the text of each attribute's value
+  std::size_t begin = 0;                  ///< byte offset of its '<'
+  std::size_t end = 0;                    ///< byte offset just after its end tag (or its "/>")
   const std::string* attribute(const std::string& key) const;
 };
+
+/// Elements nested deeper than this are refused as malformed: a URDF is a few levels deep, and urdfdom's XML
+/// parser recurses once per level (tens of thousands of levels overflow its stack).
+constexpr std::size_t kMaxXmlDepth = 256;
 
 /// checkXmlWellFormed, also filling `outline` (when not null) with every element in document order.
 bool scanXml(const std::string& text, std::string& message, std::vector<XmlElement>* outline);

@@ -24,7 +24,11 @@ class BulletCapeRun final : public SceneRun {
 
   bool build(const CapeSettings& settings, SceneKind kind, std::string& error) {
     for (int k = 0; k < scene_->characterCount(); ++k) {
-      auto cape = std::make_unique<bullet::CapeAction>(scene_->rig().fabric, settingsForScene(kind, settings),
+      // The scene's settings turned into the world (the wind's direction; gravity comes from the world).
+      CapeSettings inWorld = settingsForScene(kind, settings);
+      inWorld.wind.direction = scene_->sceneToWorld() * inWorld.wind.direction;
+      inWorld.gravity = scene_->sceneToWorld() * inWorld.gravity;
+      auto cape = std::make_unique<bullet::CapeAction>(scene_->rig().fabric, inWorld,
                                                        bullet::toBt(scene_->capePlacement(k)));
       if (!cape->ok()) {
         error = cape->cape().status().message();
@@ -53,6 +57,8 @@ class BulletCapeRun final : public SceneRun {
   double lastFrameTimeUs() const override { return frameUs_; }
   double lastCapeTimeUs() const override { return capeUs_; }
   std::string describe() const override { return scene_->describe(); }
+  Vec3 up() const override { return scene_->up(); }
+  CapeSize capeSize() const override { return scene_->capeSize(); }
 
  private:
   std::unique_ptr<BulletScene> scene_;
@@ -65,9 +71,11 @@ class BulletCapeRun final : public SceneRun {
 }  // namespace
 
 std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& error) {
-  std::unique_ptr<BulletScene> scene = BulletScene::create(options, error);
+  std::vector<std::string> warnings;
+  std::unique_ptr<BulletScene> scene = BulletScene::create(options, error, WorldKind::SoftRigid, &warnings);
+  for (const std::string& w : warnings) std::fprintf(stderr, "cape_walk: warning: %s\n", w.c_str());
   if (!scene) return nullptr;
-  for (const std::string& w : scene->warnings()) std::fprintf(stderr, "cape_walk: warning: %s\n", w.c_str());
+  for (const std::string& n : scene->notes()) std::printf("cape_walk: %s\n", n.c_str());
   auto run = std::make_unique<BulletCapeRun>(std::move(scene), options.threads);
   if (!run->build(options.settings, options.scene, error)) return nullptr;
   return run;

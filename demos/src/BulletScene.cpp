@@ -17,7 +17,8 @@ using bullet::toVec3;
 // docs/SCENES.md: the pins lie on the line (+-0.30, 1.56, 0.15) of the character frame, 4 cm above and 15 cm
 // behind the shoulder centres (+-0.22, 1.52, 0).
 const Vec3 kPinLineCentre(0.0f, 1.56f, 0.15f);
-const Vec3 kPinLineFromShoulders(0.0f, 0.04f, 0.15f);
+constexpr float kPinLineAbove = 0.04f;       // m above the shoulders' centre
+constexpr double kPinLineBehindBack = 0.03;  // m behind the back's surface
 
 Pose poseOf(const Eigen::Isometry3d& t) {
   Pose p;
@@ -54,14 +55,18 @@ struct BulletScene::Character {
   std::unique_ptr<BulletSimpleBody> simple;
 
   Vec3 offset = Vec3::Zero();
+  Vec3 shift = Vec3::Zero();  ///< moves docs/SCENES.md's pin line onto this character's (character frame)
+  std::vector<std::pair<float, btRigidBody*>> anchors;  ///< attachment bodies by their x at rest
   Pose placement;
   std::vector<PinSpec> pins;
 };
 
 std::unique_ptr<BulletScene> BulletScene::create(const RunOptions& options, std::string& error,
-                                                 WorldKind kind) {
+                                                 WorldKind kind, std::vector<std::string>* warnings) {
   std::unique_ptr<BulletScene> scene(new BulletScene());
-  if (!scene->build(options, kind, error)) return nullptr;
+  const bool built = scene->build(options, kind, error);
+  if (warnings) *warnings = scene->warnings_;
+  if (!built) return nullptr;
   return scene;
 }
 
@@ -73,12 +78,33 @@ BulletScene::~BulletScene() {
 bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error) {
   options_ = o;
   motion_ = MotionDesc::forScene(o.scene);
-  rig_ = makeCapeRig(o.size, o.pinLayout, o.settings.bendStiffness > 0.0f);
+  if (o.simpleBody && o.up != character::UpAxis::Y) {
+    error = "--up z needs a URDF character (the simple body is built in the Y-up frame of docs/SCENES.md)";
+    return false;
+  }
+  toWorld_ = character::Skeleton::sceneToWorld(o.up).cast<float>();
+  makeWorld(kind);
+
+  const int count = o.scene == SceneKind::Crowd ? std::max(1, o.characters) : 1;
+  if (o.simpleBody) {
+    body_ = "the simple body of docs/SCENES.md as kinematic Bullet bodies";
+    rig_ = makeCapeRig(o.size, o.pinLayout, o.settings.bendStiffness > 0.0f);
+    for (int k = 0; k < count; ++k) addSimpleCharacter(crowdOffset(k, count));
+    if (!o.attachLinks.empty()) warnings_.push_back("--attach is ignored with --simple-body");
+  } else {
+    if (!loadModel(o, error)) return false;
+    for (int k = 0; k < count; ++k)
+      if (!addUrdfCharacter(crowdOffset(k, count), k == 0, error)) return false;
+  }
   if (!rig_.fabric) {
     error = "cannot build a " + std::to_string(o.size) + " x " + std::to_string(o.size) + " cape";
     return false;
   }
+  for (auto& c : characters_) placeCape(*c);
+  return true;
+}
 
+void BulletScene::makeWorld(WorldKind kind) {
   configuration_ = std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(configuration_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();
@@ -106,115 +132,156 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
     info = &world->getWorldInfo();
     world_ = std::move(world);
   }
-  world_->setGravity(btVector3(0, btScalar(-9.8), 0));
+  // Gravity and the ground in the world's own axes (Y or Z up); the caps read the world's gravity.
+  world_->setGravity(toBt(toWorld(Vec3(0.0f, -9.8f, 0.0f))));
   // Soft bodies (the twins of cape_compare) take gravity and air from the world's soft body info.
   info->m_gravity = world_->getGravity();
   info->air_density = btScalar(1.2);
 
-  groundShape_ = std::make_unique<btStaticPlaneShape>(btVector3(0, 1, 0), btScalar(0));
+  groundShape_ = std::make_unique<btStaticPlaneShape>(toBt(toWorld(Vec3::UnitY())), btScalar(0));
   ground_ = std::make_unique<btRigidBody>(btScalar(0), nullptr, groundShape_.get());
   ground_->setUserIndex(-1);
   world_->addRigidBody(ground_.get());
+}
 
-  const int count = o.scene == SceneKind::Crowd ? std::max(1, o.characters) : 1;
-  character::UrdfModelPtr model;
-  if (!o.simpleBody) {
-    const character::UrdfLoadResult loaded =
-        o.urdf.empty() ? character::UrdfModel::humanoid() : character::UrdfModel::fromFile(o.urdf);
-    if (!loaded.ok()) {
-      error = (o.urdf.empty() ? std::string("shipped humanoid") : o.urdf) + ": " + loaded.status.message();
-      return false;
-    }
-    model = loaded.model;
-    warnings_ = model->warnings();
-    // The links the cape pins to: as asked, or every link named like a shoulder.
-    attachLinks_ = o.attachLinks.empty() ? model->linksContaining("shoulder") : o.attachLinks;
-    if (attachLinks_.empty()) {
-      error = "no link named like \"shoulder\" in " +
-              (o.urdf.empty() ? std::string("the humanoid") : o.urdf) +
-              ": name the links to attach to with --attach LINK[,LINK]";
-      return false;
-    }
-    for (const std::string& name : attachLinks_) {
-      if (model->findLink(name) < 0) {
-        std::string known;
-        for (const auto& l : model->links()) known += (known.empty() ? "" : ", ") + l.name;
-        error = "unknown link \"" + name + "\" (the model's links: " + known + ")";
-        return false;
-      }
-    }
-    body_ = (o.urdf.empty() ? std::string("the shipped humanoid (character/models/humanoid.urdf)")
-                            : "URDF " + o.urdf);
-  } else {
-    body_ = "the simple body of docs/SCENES.md as kinematic Bullet bodies";
+bool BulletScene::loadModel(const RunOptions& o, std::string& error) {
+  character::UrdfLoadOptions load;
+  load.packagePaths = o.packagePaths;
+  const character::UrdfLoadResult loaded =
+      o.urdf.empty() ? character::UrdfModel::humanoid() : character::UrdfModel::fromFile(o.urdf, load);
+  warnings_ = loaded.warnings;  // also when the load failed: they may say why
+  if (!loaded.ok()) {
+    error = (o.urdf.empty() ? std::string("shipped humanoid") : o.urdf) + ": " + loaded.status.message();
+    return false;
   }
-
-  for (int k = 0; k < count; ++k) {
-    auto c = std::make_unique<Character>();
-    c->offset = crowdOffset(k, count);
-    Vec3 shift = c->offset;  // moves docs/SCENES.md's pin line onto this character's
-    std::vector<std::pair<float, btRigidBody*>> anchors;  // attachment bodies by their x at rest
-    if (model) {
-      character::CharacterSettings cs;
-      cs.offset = c->offset.cast<double>();
-      character::CharacterResult made =
-          character::Character::create(model, *world_, character::Gait::forScene(o.scene), cs);
-      if (!made.ok()) {
-        error = made.status.message();
-        return false;
-      }
-      c->urdf = std::move(made.character);
-      for (const character::WorldShape& w : c->urdf->skeleton().worldShapes())
-        c->hulls.push_back(w.shape->type == character::ShapeType::ConvexHull ? hullOf(*w.shape) : nullptr);
-      if (k == 0)
-        for (const std::string& w : c->urdf->warnings())
-          if (std::find(warnings_.begin(), warnings_.end(), w) == warnings_.end()) warnings_.push_back(w);
-      const int torso = model->findLink("torso");
-      c->torsoLink = torso >= 0 ? torso : 0;
-      Vec3 centre = Vec3::Zero();
-      for (const std::string& name : attachLinks_) {
-        const int link = model->findLink(name);
-        const Vec3 at = c->urdf->skeleton().linkPose(link).translation().cast<float>();
-        centre += at / static_cast<float>(attachLinks_.size());
-        btRigidBody* body = c->urdf->bodies().bodyForLink(link);
-        if (!body) {
-          error = "link \"" + name + "\" has no collision shape, so no body to attach the cape to";
-          return false;
-        }
-        anchors.emplace_back(at.x(), body);
-      }
-      shift = centre + kPinLineFromShoulders - kPinLineCentre;
-    } else {
-      // Torso, shoulders and legs as kinematic bodies, at the scene's starting pose (the world's ground is
-      // shared by every character).
-      c->simple = std::make_unique<BulletSimpleBody>(*world_, c->offset, motionAt(motion_, 0.0));
-      if (o.pinLayout == PinLayout::Collar) {
-        anchors.emplace_back(0.0f, c->simple->rigidBody(SimpleBody::kTorso));
-      } else {
-        anchors.emplace_back(-1.0f, c->simple->rigidBody(SimpleBody::kLeftShoulder));
-        anchors.emplace_back(1.0f, c->simple->rigidBody(SimpleBody::kRightShoulder));
-      }
-    }
-    std::sort(anchors.begin(), anchors.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-
-    // The cape starts as docs/SCENES.md says, moved onto this character's pin line; each pinned particle goes
-    // to the attachment body nearest to it along X (left corner to the left shoulder, and so on).
-    const Pose start = capeStartPlacement(o.scene);
-    c->placement.position = start.position + shift;
-    c->placement.rotation = start.rotation;
-    for (std::size_t p = 0; p < rig_.pinnedParticles.size(); ++p) {
-      const Vec3 point = rig_.pinLocalPoints[p] + shift;
-      const auto nearest =
-          std::min_element(anchors.begin(), anchors.end(), [&](const auto& a, const auto& b) {
-            return std::fabs(a.first - point.x()) < std::fabs(b.first - point.x());
-          });
-      btRigidBody* body = nearest->second;
-      c->pins.push_back({rig_.pinnedParticles[p], body, body->getWorldTransform().inverse() * toBt(point)});
-    }
-    characters_.push_back(std::move(c));
-  }
-  if (o.simpleBody && !o.attachLinks.empty()) warnings_.push_back("--attach is ignored with --simple-body");
+  model_ = loaded.model;
+  body_ = (o.urdf.empty() ? std::string("the shipped humanoid (character/models/humanoid.urdf)")
+                          : "URDF " + o.urdf);
   return true;
+}
+
+void BulletScene::addSimpleCharacter(const Vec3& offset) {
+  // Torso, shoulders and legs as kinematic bodies, at the scene's starting pose (the world's ground is shared
+  // by every character).
+  auto c = std::make_unique<Character>();
+  c->offset = offset;
+  c->simple = std::make_unique<BulletSimpleBody>(*world_, offset, motionAt(motion_, 0.0));
+  if (options_.pinLayout == PinLayout::Collar) {
+    c->anchors.emplace_back(0.0f, c->simple->rigidBody(SimpleBody::kTorso));
+  } else {
+    c->anchors.emplace_back(-1.0f, c->simple->rigidBody(SimpleBody::kLeftShoulder));
+    c->anchors.emplace_back(1.0f, c->simple->rigidBody(SimpleBody::kRightShoulder));
+  }
+  c->shift = offset;  // docs/SCENES.md's pin line, moved onto this character
+  characters_.push_back(std::move(c));
+}
+
+bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& error) {
+  auto c = std::make_unique<Character>();
+  c->offset = offset;
+  character::CharacterSettings cs;
+  cs.offset = offset.cast<double>();
+  cs.up = options_.up;
+  cs.rootHeight = options_.rootHeight;
+  cs.pose = options_.pose;
+  character::CharacterResult made =
+      character::Character::create(model_, *world_, character::Gait::forScene(options_.scene), cs);
+  if (!made.ok()) {
+    error = made.status.message();
+    return false;
+  }
+  c->urdf = std::move(made.character);
+  for (const character::WorldShape& w : c->urdf->skeleton().worldShapes())
+    c->hulls.push_back(w.shape->type == character::ShapeType::ConvexHull ? hullOf(*w.shape) : nullptr);
+  if (first)
+    for (const std::string& w : c->urdf->warnings())
+      if (std::find(warnings_.begin(), warnings_.end(), w) == warnings_.end()) warnings_.push_back(w);
+
+  // Where the cape hangs: on the links asked for, or on the shoulders the joint mapping found.
+  const character::ShoulderAnchors a =
+      options_.attachLinks.empty() ? character::findShoulderAnchors(*c->urdf)
+                                   : character::shoulderAnchorsOnLinks(*c->urdf, options_.attachLinks);
+  if (!a.status.ok()) {
+    error =
+        a.status.message() + (options_.attachLinks.empty() ? "; name the links to pin to with --attach" : "");
+    return false;
+  }
+  c->torsoLink = a.upperTorsoLink;
+  std::vector<int> links;
+  if (options_.pinLayout == PinLayout::Collar) {
+    links = {a.upperTorsoLink};
+  } else if (options_.attachLinks.empty()) {
+    links = {a.leftLink, a.rightLink};
+  } else {
+    for (const std::string& name : options_.attachLinks) links.push_back(model_->findLink(name));
+  }
+  const Eigen::Matrix3d toScene = character::Skeleton::sceneToWorld(options_.up).transpose();
+  for (int link : links) {
+    btRigidBody* body = c->urdf->bodies().bodyForLink(link);
+    if (!body) {
+      error = "link \"" + model_->links()[static_cast<std::size_t>(link)].name +
+              "\" has no collision shape, so no body to attach the cape to";
+      return false;
+    }
+    const Eigen::Vector3d at = toScene * c->urdf->skeleton().linkPose(link).translation();
+    c->anchors.emplace_back(static_cast<float>(at.x()), body);
+  }
+  // The pin line: 4 cm above the shoulders' centre and 3 cm behind the back (docs/SCENES.md: 15 cm behind
+  // the shipped humanoid's shoulders, whose back is 12 cm behind them). In float as it always was, so the
+  // shipped humanoid's cape starts where it did to the bit.
+  const Vec3 centre = a.left.cast<float>() / 2.0f + a.right.cast<float>() / 2.0f;
+  const Vec3 above(0.0f, kPinLineAbove, static_cast<float>(a.back + kPinLineBehindBack));
+  c->shift = centre + above - kPinLineCentre;
+  if (first) {
+    // The cape's width follows the shoulders (8 cm beyond each), its length the height of the pins (it ends
+    // 45 cm above the ground at most, 1 m long at most), both to the millimetre.
+    const double span = std::fabs(a.right.x() - a.left.x());
+    CapeSize size;
+    size.width = static_cast<float>(std::round(std::clamp(span + 2.0 * 0.08, 0.2, 3.0) * 1000.0) / 1000.0);
+    const double pinHeight = 0.5 * (a.left.y() + a.right.y()) + kPinLineAbove;
+    size.height = static_cast<float>(std::round(std::clamp(pinHeight - 0.45, 0.2, 1.0) * 1000.0) / 1000.0);
+    capeSize_ = size;
+    rig_ = makeCapeRig(options_.size, options_.pinLayout, options_.settings.bendStiffness > 0.0f, size);
+    attachDescription_ = a.description;
+    char line[160];
+    std::snprintf(line, sizeof line, "; a %.2f x %.2f m cape, its top %.0f cm behind the shoulders",
+                  size.width, size.height, 100.0 * (a.back + kPinLineBehindBack));
+    notes_.push_back(a.description + line);
+    std::snprintf(line, sizeof line, "the root link '%s' %.3f m above the ground (%s)",
+                  model_->links()[0].name.c_str(), c->urdf->rootHeight(),
+                  options_.rootHeight ? "--root-height" : "its lowest collision point on the ground");
+    notes_.push_back(line);
+    for (int link : links) attachLinks_.push_back(model_->links()[static_cast<std::size_t>(link)].name);
+  }
+  characters_.push_back(std::move(c));
+  return true;
+}
+
+void BulletScene::placeCape(Character& c) {
+  // The cape starts as docs/SCENES.md says, moved onto this character's pin line and turned into the world;
+  // each pinned particle goes to the attachment body nearest to it along the character's X (left corner to
+  // the left shoulder, and so on).
+  std::sort(c.anchors.begin(), c.anchors.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  const Pose start = capeStartPlacement(options_.scene, capeSize_);
+  c.placement.position = toWorld(start.position + c.shift);
+  c.placement.rotation = Quat(toWorld_) * start.rotation;
+  if (options_.up == character::UpAxis::Y) c.placement.rotation = start.rotation;  // the same bits as ever
+  for (std::size_t p = 0; p < rig_.pinnedParticles.size(); ++p) {
+    const Vec3 point = rig_.pinLocalPoints[p] + c.shift;
+    const auto nearest =
+        std::min_element(c.anchors.begin(), c.anchors.end(), [&](const auto& a, const auto& b) {
+          return std::fabs(a.first - point.x()) < std::fabs(b.first - point.x());
+        });
+    btRigidBody* body = nearest->second;
+    c.pins.push_back(
+        {rig_.pinnedParticles[p], body, body->getWorldTransform().inverse() * toBt(toWorld(point))});
+  }
+}
+
+Vec3 BulletScene::toWorld(const Vec3& scene) const {
+  if (options_.up == character::UpAxis::Y) return scene;
+  return toWorld_ * scene;
 }
 
 void BulletScene::poseAt(double t) {

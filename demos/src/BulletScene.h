@@ -7,6 +7,7 @@
 
 #include "SceneRun.h"
 
+#include "cape/character/Anchors.h"
 #include "cape/character/Character.h"
 
 #include <BulletSoftBody/btDeformableBodySolver.h>
@@ -38,8 +39,11 @@ class BulletScene {
  public:
   /// Builds the world and its characters for the options; nullptr and a one-line reason on bad input
   /// (unreadable or malformed URDF, unknown attachment link, no link to attach to).
+  /// `warnings`, when given, receives what was said on the way, also when the build fails (a URDF's skipped
+  /// elements may be why).
   static std::unique_ptr<BulletScene> create(const RunOptions& options, std::string& error,
-                                             WorldKind kind = WorldKind::SoftRigid);
+                                             WorldKind kind = WorldKind::SoftRigid,
+                                             std::vector<std::string>* warnings = nullptr);
   ~BulletScene();
   BulletScene(const BulletScene&) = delete;
   BulletScene& operator=(const BulletScene&) = delete;
@@ -73,11 +77,24 @@ class BulletScene {
   std::string describe() const;
   /// Load and mapping warnings worth printing once (meshes left out, joints the gait could not map).
   const std::vector<std::string>& warnings() const { return warnings_; }
+  /// What was chosen for the user (where the cape is pinned, its size), worth printing once.
+  const std::vector<std::string>& notes() const { return notes_; }
+  /// The world's up direction (+Y, or +Z with --up z), and the turn from the Y-up scene frame into the world.
+  Vec3 up() const { return toWorld_ * Vec3::UnitY(); }
+  const Eigen::Matrix3f& sceneToWorld() const { return toWorld_; }
+  /// The cape's size (canonical, or fitted to the character's shoulders).
+  const CapeSize& capeSize() const { return capeSize_; }
 
  private:
   struct Character;
   BulletScene() = default;
   bool build(const RunOptions& options, WorldKind kind, std::string& error);
+  void makeWorld(WorldKind kind);
+  bool loadModel(const RunOptions& options, std::string& error);
+  void addSimpleCharacter(const Vec3& offset);
+  bool addUrdfCharacter(const Vec3& offset, bool first, std::string& error);
+  void placeCape(Character& c);
+  Vec3 toWorld(const Vec3& scene) const;
   void poseAt(double t);
 
   // Bullet's world, in construction order (destroyed in reverse).
@@ -94,11 +111,16 @@ class BulletScene {
 
   RunOptions options_;
   MotionDesc motion_;
+  Eigen::Matrix3f toWorld_ = Eigen::Matrix3f::Identity();  ///< Y-up scene frame -> world
+  character::UrdfModelPtr model_;
+  CapeSize capeSize_;
   CapeRig rig_;
   std::vector<std::unique_ptr<Character>> characters_;
   std::vector<std::string> attachLinks_;
   std::string body_;
   std::vector<std::string> warnings_;
+  std::vector<std::string> notes_;
+  std::string attachDescription_;
 };
 
 }  // namespace cape::demo

@@ -1,5 +1,9 @@
 #include "SceneOptions.h"
 
+#include "cape/character/Character.h"
+
+#include <cmath>
+
 namespace cape::demo {
 
 void addSceneOptions(CLI::App& app, SceneCli& cli) {
@@ -22,11 +26,37 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
   app.add_option("--urdf", cli.urdf, "character URDF file (default: the shipped humanoid)")
       ->check(CLI::ExistingFile);
   app.add_option("--attach", cli.attach,
-                 "comma-separated links the cape pins to (default: links named *shoulder*)");
+                 "comma-separated links the cape pins to (default: where the joint mapping finds the "
+                 "shoulders)");
+  app.add_option("--package-path", cli.packagePaths,
+                 "folder where package://NAME/... mesh URIs are looked up (as DIR/NAME/...; repeatable; "
+                 "then ROS_PACKAGE_PATH)");
+  app.add_option("--up", cli.up, "the world's up axis: y (docs/SCENES.md) | z (ROS, PyBullet)")
+      ->check(CLI::IsMember({"y", "z"}))
+      ->capture_default_str();
+  app.add_option("--root-height", cli.rootHeight,
+                 "height of the URDF's root link above the ground, m (default: its lowest collision point "
+                 "touches the ground)");
+  app.add_option("--pose", cli.pose,
+                 "starting joint positions, rad (or m): name=value,name=value; the gait moves from there");
 }
 
-RunOptions toRunOptions(const SceneCli& cli) {
-  RunOptions o;
+bool toRunOptions(const SceneCli& cli, RunOptions& o, std::string& error) {
+  o = RunOptions();
+  o.packagePaths = cli.packagePaths;
+  o.up = cli.up == "z" ? character::UpAxis::Z : character::UpAxis::Y;
+  o.rootHeight = cli.rootHeight;
+  if (!cli.pose.empty()) {
+    const character::Status s = character::parsePose(cli.pose, o.pose);
+    if (!s.ok()) {
+      error = "--pose: " + s.message();
+      return false;
+    }
+  }
+  if (o.rootHeight && !std::isfinite(*o.rootHeight)) {
+    error = "--root-height must be a finite number of metres";
+    return false;
+  }
   parseSceneKind(cli.scene, o.scene);
   parsePinLayout(cli.attachment, o.pinLayout);
   o.size = cli.size;
@@ -42,7 +72,7 @@ RunOptions toRunOptions(const SceneCli& cli) {
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
-  return o;
+  return true;
 }
 
 }  // namespace cape::demo

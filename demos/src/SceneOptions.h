@@ -5,7 +5,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace cape::demo {
 
@@ -18,12 +20,18 @@ struct SceneCli {
   int characters = 3;
   double seconds = -1.0;
   bool simpleBody = false;
+  std::vector<std::string> packagePaths;
+  std::string up = "y";
+  std::optional<double> rootHeight;
+  std::string pose;  ///< name=rad,name=rad,...
 };
 
-/// Adds --scene, --size, --attachment, --seconds, --characters, --simple-body, --urdf and --attach.
+/// Adds --scene, --size, --attachment, --seconds, --characters, --simple-body, --urdf, --attach,
+/// --package-path, --up, --root-height and --pose.
 void addSceneOptions(CLI::App& app, SceneCli& cli);
 
 /// The run options they ask for (the attachment links split at commas; one character unless the crowd).
-RunOptions toRunOptions(const SceneCli& cli);
+/// False and a message when --pose cannot be read.
+bool toRunOptions(const SceneCli& cli, RunOptions& options, std::string& error);
 
 }  // namespace cape::demo

@@ -2,11 +2,14 @@
 // in a Bullet world (BulletScene.h), the cape attached through the Bullet adapter.
 #pragma once
 
+#include "cape/character/Skeleton.h"
 #include "cape/scenes/Metrics.h"
 #include "cape/scenes/Scene.h"
 
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cape::demo {
@@ -22,7 +25,12 @@ struct RunOptions {
   CapeSettings settings;
   bool simpleBody = false;
   std::string urdf;                      ///< empty: the shipped humanoid
-  std::vector<std::string> attachLinks;  ///< empty: found by name ("shoulder")
+  std::vector<std::string> attachLinks;  ///< empty: the joint mapping's shoulders
+  std::vector<std::string>
+      packagePaths;  ///< where package:// mesh URIs are looked up (then ROS_PACKAGE_PATH)
+  character::UpAxis up = character::UpAxis::Y;       ///< the world's up axis
+  std::optional<double> rootHeight;                  ///< m; empty: the character stands on the ground
+  std::vector<std::pair<std::string, double>> pose;  ///< the character's starting joint positions by name
 };
 
 class SceneRun {
@@ -40,6 +48,10 @@ class SceneRun {
   virtual double lastCapeTimeUs() const = 0;
   /// A description for summary.json (body, URDF, attachment links, stepping).
   virtual std::string describe() const = 0;
+  /// The world's up direction (the ground is the plane through the origin normal to it).
+  virtual Vec3 up() const = 0;
+  /// The cape's size (the canonical 0.6 x 1.0 m, or fitted to the character's shoulders).
+  virtual CapeSize capeSize() const = 0;
 };
 
 /// The run the options ask for: the shipped humanoid, a URDF character or the simple body, in a Bullet

@@ -188,7 +188,12 @@ int main(int argc, char** argv) {
   app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  const RunOptions o = toRunOptions(sceneCli);
+  RunOptions o;
+  std::string optionError;
+  if (!toRunOptions(sceneCli, o, optionError)) {
+    std::fprintf(stderr, "cape_compare: %s\n", optionError.c_str());
+    return 1;
+  }
   const std::string& scene = sceneCli.scene;
   const int size = sceneCli.size;
 

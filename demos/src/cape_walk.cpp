@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 
 using namespace cape;
@@ -49,7 +50,12 @@ int main(int argc, char** argv) {
   app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  RunOptions o = toRunOptions(sceneCli);
+  RunOptions o;
+  std::string optionError;
+  if (!toRunOptions(sceneCli, o, optionError)) {
+    std::fprintf(stderr, "cape_walk: %s\n", optionError.c_str());
+    return 1;
+  }
   o.threads = threads;
   const std::string& scene = sceneCli.scene;
   const std::string& attachment = sceneCli.attachment;
@@ -113,6 +119,10 @@ int main(int argc, char** argv) {
   rows.reserve(static_cast<std::size_t>(frames));
   Progress progress("cape_walk " + scene, frames);
   bool blowUp = false;
+  // The lowest particle above the ground over the run (m; the ground is the plane through the origin normal
+  // to the world's up): a cape that hangs on the back stays well above it.
+  double lowest = std::numeric_limits<double>::infinity();
+  const Vec3 up = run->up();
   for (int f = 1; f <= frames && !blowUp; ++f) {
     run->advanceFrame();
     FrameRow row;
@@ -126,6 +136,8 @@ int main(int argc, char** argv) {
       const FrameMetrics m =
           measureFrame(run->cape(k), colliders, run->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
       recorders[static_cast<std::size_t>(k)].add(m);
+      if (run->cape(k).state().positions.rows() > 0)
+        lowest = std::min(lowest, static_cast<double>((run->cape(k).state().positions * up).minCoeff()));
       row.metrics = k == 0 ? m : worstOf(row.metrics, m);  // a crowd's row holds the worst of its characters
       writer->capeMesh(f, k, run->cape(k));
       if (gltfRecorder) gltfRecorder->record(k, run->cape(k), colliders);
@@ -170,11 +182,15 @@ int main(int argc, char** argv) {
                      {"rows", size},
                      {"particles", size * size},
                      {"springs", run->cape(0).fabric().springCount()}};
-  summary["cape"] = {{"width_m", 0.6}, {"height_m", 1.0}, {"mass_kg", run->cape(0).fabric().totalMass()}};
+  summary["cape"] = {{"width_m", run->capeSize().width},
+                     {"height_m", run->capeSize().height},
+                     {"mass_kg", run->cape(0).fabric().totalMass()}};
   summary["frame_time_s"] = 1.0 / 60.0;
   summary["seconds"] = length;
   summary["settings"] = settingsJson(settingsForScene(o.scene, o.settings));
   summary["summary"] = summaryFigures(rows, q);
+  summary["summary"]["lowest_particle_m"] = std::isfinite(lowest) ? lowest : 0.0;
+  summary["up"] = o.up == character::UpAxis::Z ? "z" : "y";
   // Each cape's final state (stateHash: the bits of its positions and velocities), for determinism checks.
   for (int k = 0; k < run->characterCount(); ++k) {
     char hex[32];
@@ -207,6 +223,7 @@ int main(int argc, char** argv) {
   std::printf("  %-34s %10d    (%d frames with any)\n", "self-intersections, max", q.selfIntersectionsMax,
               q.framesWithSelfIntersections);
   std::printf("  %-34s %10.2g m\n", "pin error, max", q.pinErrorMax);
+  std::printf("  %-34s %10.3f m\n", "lowest particle above the ground", std::isfinite(lowest) ? lowest : 0.0);
   if (o.scene == SceneKind::Hang)
     std::printf("  %-34s %10.4f m/s\n", "rest jitter (last second)", q.restJitter);
   std::printf("  %-34s %10s\n", "blow-up", q.blowUp ? "YES" : "no");

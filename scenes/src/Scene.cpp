@@ -193,7 +193,7 @@ void SimpleBody::moveTo(const BodyPose& pose, bool teleport) {
   }
 }
 
-CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings) {
+CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings, const CapeSize& size) {
   CapeRig rig;
   const int cols = std::max(n, 2);
   if (layout == PinLayout::Corners) {
@@ -201,25 +201,27 @@ CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings) {
   } else {
     for (int c = 0; c < cols; ++c) rig.pinnedParticles.push_back(static_cast<std::uint32_t>(c));
   }
+  const float half = 0.5f * size.width;  // the canonical 0.6 gives kPinLine.x() exactly
   for (std::uint32_t p : rig.pinnedParticles) {
     const float u = static_cast<float>(p) / static_cast<float>(cols - 1);
-    rig.pinLocalPoints.emplace_back(-kPinLine.x() + u * 2.0f * kPinLine.x(), kPinLine.y(), kPinLine.z());
+    rig.pinLocalPoints.emplace_back(-half + u * 2.0f * half, kPinLine.y(), kPinLine.z());
   }
   GridDesc g;
   g.columns = n;
   g.rows = n;
-  g.width = 2.0f * kPinLine.x();
-  g.height = 1.0f;
-  g.totalMass = 0.4f;
+  g.width = 2.0f * half;
+  g.height = size.height;
+  // 0.4 kg on the canonical 0.6 m^2; the same mass per area on any other size (exactly 0.4 on the canonical).
+  g.totalMass = 0.4f * ((g.width * g.height) / (2.0f * kPinLine.x() * 1.0f));
   g.bendSprings = bendSprings;
   g.tetherAnchors = rig.pinnedParticles;
   rig.fabric = Fabric::grid(g).fabric;
   return rig;
 }
 
-Pose capeStartPlacement(SceneKind kind) {
+Pose capeStartPlacement(SceneKind kind, const CapeSize& size) {
   Pose p;
-  p.position = Vec3(-kPinLine.x(), kPinLine.y(), kPinLine.z());  // the grid's top-left on the left pin
+  p.position = Vec3(-0.5f * size.width, kPinLine.y(), kPinLine.z());  // the grid's top-left on the left pin
   if (kind == SceneKind::Hang) {
     // Rotate the grid's -Y (down the cape) onto +Z (away from the back): -90 degrees about X.
     p.rotation = Quat(Eigen::AngleAxisf(-static_cast<float>(kPi / 2), Vec3::UnitX()));

@@ -3,7 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 using namespace cape::character;
@@ -209,14 +213,183 @@ TEST(Urdf, MeshCollisionIsSkippedWithAWarningNamingTheLink) {
   EXPECT_EQ(r.model->links()[0].shapes[0].type, ShapeType::Box);
 }
 
-TEST(Urdf, UnreadableGeometryBecomesAWarning) {
-  // URDF has no capsule; urdfdom drops the element and says so, and we pass its words on.
+TEST(Urdf, CapsulesAreReadAlongTheirZAsBulletsImporterReadsThem) {
+  // Bullet's data/humanoid.urdf style: a capsule first, then a sphere; urdfdom alone drops both.
   const UrdfLoadResult r = UrdfModel::fromString(
-      R"(<robot name="c"><link name="l"><collision><geometry><capsule radius="1" length="2"/></geometry>
-         </collision></link></robot>)");
+      R"(<robot name="c"><link name="l">
+           <collision name="arm"><origin xyz="0 0 0.3" rpy="0 1.5707963 0"/>
+             <geometry><capsule radius="0.05" length="0.4"/></geometry></collision>
+           <collision><geometry><sphere radius="0.1"/></geometry></collision>
+         </link></robot>)");
   ASSERT_TRUE(r.ok()) << r.status.message();
-  ASSERT_FALSE(r.model->warnings().empty());
-  EXPECT_NE(r.model->warnings()[0].find("capsule"), std::string::npos) << r.model->warnings()[0];
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
+  const LinkDesc& l = r.model->links()[0];
+  ASSERT_EQ(l.shapes.size(), 2u);
+  EXPECT_EQ(l.shapes[0].type, ShapeType::Capsule);
+  EXPECT_EQ(l.shapes[0].name, "arm");
+  EXPECT_DOUBLE_EQ(l.shapes[0].radius, 0.05);
+  EXPECT_DOUBLE_EQ(l.shapes[0].halfLength, 0.2);  // length is the distance between the sphere centres
+  EXPECT_NEAR(l.shapes[0].origin.translation().z(), 0.3, 1e-12);
+  EXPECT_NEAR((l.shapes[0].origin.linear() * Eigen::Vector3d::UnitZ()).x(), 1.0, 1e-6);  // pitched onto x
+  EXPECT_EQ(l.shapes[1].type, ShapeType::Sphere);
+  EXPECT_EQ(l.shapes[1].name, "l#1");
+}
+
+TEST(Urdf, NumbersWithWhiteSpaceAroundThemAreReadAndSaidOnce) {
+  // urdfdom refuses " 1.0 " as a number and then drops every shape of the link after its <inertial>; and
+  // " -1 " in a joint limit would make it refuse the model.
+  const UrdfLoadResult r = UrdfModel::fromString(
+      R"(<robot name="s">
+           <link name="a"><inertial><mass value=" 2.5 "/><inertia ixx=" 0.1" ixy="0" ixz="0" iyy="0.1 "
+             iyz="0" izz="0.1"/></inertial>
+             <collision><origin xyz=" 0 0	0.5 "/><geometry><box size="0.2  0.2 0.2 "/></geometry></collision>
+           </link>
+           <link name="b"><collision><geometry><cylinder radius=" 0.1" length="0.5 "/></geometry></collision></link>
+           <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/>
+             <limit lower=" -1 " upper="1" effort="1" velocity="1"/></joint>
+         </robot>)");
+  ASSERT_TRUE(r.ok()) << r.status.message();
+  const LinkDesc& a = linkNamed(*r.model, "a");
+  EXPECT_DOUBLE_EQ(a.mass, 2.5);
+  ASSERT_EQ(a.shapes.size(), 1u);
+  EXPECT_EQ(a.shapes[0].halfExtents, Eigen::Vector3d(0.1, 0.1, 0.1));
+  EXPECT_DOUBLE_EQ(a.shapes[0].origin.translation().z(), 0.5);
+  ASSERT_EQ(linkNamed(*r.model, "b").shapes.size(), 1u);
+  EXPECT_DOUBLE_EQ(jointNamed(*r.model, "j").lower, -1.0);
+  ASSERT_EQ(r.model->warnings().size(), 1u);  // one line for every such value, naming the first
+  EXPECT_NE(r.model->warnings()[0].find("white space"), std::string::npos) << r.model->warnings()[0];
+  EXPECT_NE(r.model->warnings()[0].find("joint 'j'"), std::string::npos) << r.model->warnings()[0];
+}
+
+TEST(Urdf, TextEndsAtItsFirstNulByteAsForBulletsImporter) {
+  // PyBullet's humanoid.urdf ships with a NUL after </robot>.
+  std::string xml = twoJointUrdf();
+  xml += std::string("\n\0", 2);
+  const UrdfLoadResult quiet = UrdfModel::fromString(xml);
+  ASSERT_TRUE(quiet.ok()) << quiet.status.message();
+  EXPECT_TRUE(quiet.warnings.empty());  // only NULs and white space after it: nothing worth saying
+  xml += "garbage";
+  const UrdfLoadResult said = UrdfModel::fromString(xml);
+  ASSERT_TRUE(said.ok()) << said.status.message();
+  ASSERT_EQ(said.warnings.size(), 1u);
+  EXPECT_NE(said.warnings[0].find("NUL"), std::string::npos) << said.warnings[0];
+}
+
+TEST(Urdf, MissingInertialIsFine) {
+  const UrdfLoadResult r = UrdfModel::fromString(twoJointUrdf());
+  ASSERT_TRUE(r.ok()) << r.status.message();
+  EXPECT_EQ(linkNamed(*r.model, "a").mass, 0.0);
+  EXPECT_TRUE(r.warnings.empty());
+}
+
+TEST(Urdf, EveryUnusableElementIsSkippedWithOneWarningNamingLinkElementAndReason) {
+  const UrdfLoadResult r = UrdfModel::fromString(
+      R"(<robot name="bad"><link name="l">
+           <collision name="zero"><geometry><sphere radius="0"/></geometry></collision>
+           <collision name="nan"><geometry><box size="1 nan 1"/></geometry></collision>
+           <collision name="two"><geometry><box size="1 1"/></geometry></collision>
+           <collision name="odd"><geometry><torus radius="1"/></geometry></collision>
+           <collision name="empty"><geometry/></collision>
+           <collision name="origin"><origin xyz="0 0"/><geometry><sphere radius="1"/></geometry></collision>
+           <collision name="ok"><geometry><sphere radius="1"/></geometry></collision>
+         </link></robot>)");
+  ASSERT_TRUE(r.ok()) << r.status.message();
+  ASSERT_EQ(r.model->links()[0].shapes.size(), 1u);
+  EXPECT_EQ(r.model->links()[0].shapes[0].name, "ok");
+  ASSERT_EQ(r.warnings.size(), 6u);
+  for (const char* name : {"zero", "nan", "two", "odd", "empty", "origin"}) {
+    const auto it = std::find_if(r.warnings.begin(), r.warnings.end(), [&](const std::string& w) {
+      return w.find(std::string("'") + name + "'") != std::string::npos &&
+             w.find("link 'l'") != std::string::npos && w.find("skipped") != std::string::npos;
+    });
+    EXPECT_NE(it, r.warnings.end()) << name;
+  }
+}
+
+TEST(Urdf, WarningsComeBackWithAFailedLoad) {
+  // The capsule's warning is said, then the missing link fails the load: the caller sees both.
+  const UrdfLoadResult r = UrdfModel::fromString(
+      R"(<robot name="f"><link name="a"><collision name="c"><geometry><capsule radius="-1" length="1"/>
+         </geometry></collision></link>
+         <joint name="j" type="fixed"><parent link="a"/><child link="ghost"/></joint></robot>)");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status.code(), ErrorCode::MissingLink) << r.status.message();
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("'c'"), std::string::npos) << r.warnings[0];
+}
+
+TEST(Urdf, DeepNestingIsRefusedAsMalformedNotACrash) {
+  std::string xml = "<robot name=\"deep\">";
+  for (int i = 0; i < 40000; ++i) xml += "<a>";
+  for (int i = 0; i < 40000; ++i) xml += "</a>";
+  xml += "</robot>";
+  const UrdfLoadResult r = UrdfModel::fromString(xml);
+  EXPECT_EQ(r.status.code(), ErrorCode::MalformedXml) << r.status.message();
+  EXPECT_NE(r.status.message().find("nested deeper"), std::string::npos) << r.status.message();
+}
+
+TEST(Urdf, MeshElementsBecomeHullsAndMissingOrEmptyMeshesAreSkippedWithAWarning) {
+  // A package folder the test writes: an ASCII STL cube of side 2 (mm scale in the URDF), an empty STL.
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("cape_urdf_meshes-" + std::to_string(::getpid())) / "robot";
+  std::filesystem::create_directories(dir / "meshes");
+  {
+    std::ofstream stl(dir / "meshes" / "cube.stl");
+    stl << "solid c\n";
+    const int f[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                          {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    for (const auto& t : f) {
+      stl << "facet normal 0 0 0\nouter loop\n";
+      for (int k : t)
+        stl << "vertex " << (k & 1 ? 1000 : -1000) << " " << (k & 2 ? 1000 : -1000) << " "
+            << (k & 4 ? 1000 : -1000) << "\n";
+      stl << "endloop\nendfacet\n";
+    }
+    stl << "endsolid c\n";
+    std::ofstream(dir / "meshes" / "empty.stl");
+  }
+  const std::string xml = R"(<robot name="m"><link name="body">
+      <collision name="cube"><geometry><mesh filename="package://robot/meshes/cube.stl" scale="0.0001 0.0002 0.0003"/></geometry></collision>
+      <collision name="empty"><geometry><mesh filename="package://robot/meshes/empty.stl"/></geometry></collision>
+      <collision name="missing"><geometry><mesh filename="meshes/missing.stl"/></geometry></collision>
+    </link></robot>)";
+  UrdfLoadOptions options;
+  options.packagePaths = {dir.parent_path().string()};
+  options.baseDir = dir.string();
+  const UrdfLoadResult r = UrdfModel::fromString(xml, options);
+  ASSERT_TRUE(r.ok()) << r.status.message();
+  const LinkDesc& body = r.model->links()[0];
+  ASSERT_EQ(body.shapes.size(), 1u);
+  const ShapeDesc& hull = body.shapes[0];
+  EXPECT_EQ(hull.type, ShapeType::ConvexHull);
+  EXPECT_EQ(hull.name, "cube");
+  EXPECT_EQ(hull.hull.size(), 8u);
+  EXPECT_EQ(hull.hullPlanes.size(), 6u);
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : hull.hull) box.extend(v);
+  EXPECT_TRUE(box.max().isApprox(Eigen::Vector3d(0.1, 0.2, 0.3), 1e-9)) << box.max().transpose();
+  EXPECT_NE(hull.meshFile.find("cube.stl"), std::string::npos);
+  ASSERT_EQ(r.warnings.size(), 2u);
+  EXPECT_NE(r.warnings[0].find("'empty'"), std::string::npos) << r.warnings[0];
+  EXPECT_NE(r.warnings[1].find("'missing'"), std::string::npos) << r.warnings[1];
+  for (const std::string& w : r.warnings) EXPECT_NE(w.find("link 'body'"), std::string::npos) << w;
+  // Meshes off: every mesh element skipped, each with its warning, no file opened.
+  options.loadMeshes = false;
+  const UrdfLoadResult off = UrdfModel::fromString(xml, options);
+  ASSERT_TRUE(off.ok());
+  EXPECT_TRUE(off.model->links()[0].shapes.empty());
+  EXPECT_EQ(off.warnings.size(), 3u);
+  std::filesystem::remove_all(dir.parent_path());
+}
+
+TEST(Urdf, SphericalJointsAreReadAsHeldJointsWithAWarning) {
+  const UrdfLoadResult r = UrdfModel::fromString(
+      R"(<robot name="s"><link name="a"/><link name="b"/>
+         <joint name="ball" type="spherical"><parent link="a"/><child link="b"/></joint></robot>)");
+  ASSERT_TRUE(r.ok()) << r.status.message();
+  EXPECT_FALSE(jointNamed(*r.model, "ball").isMovable());
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("'ball'"), std::string::npos) << r.warnings[0];
 }
 
 TEST(Urdf, XmlCheckAcceptsOrdinaryDocuments) {

@@ -40,6 +40,9 @@ struct CharacterSettings {
   double scale = 1.0;                                ///< uniform scale of the URDF, > 0
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();  ///< m, world, added to the gait's root path (a crowd)
   BodySettings bodies;                               ///< collision group, mask, ...
+  /// The world's up axis: the gait and the offset stay in the Y-up scene frame, the bodies are turned into
+  /// the world by Skeleton::sceneToWorld(up).
+  UpAxis up = UpAxis::Y;
   /// m: the height of the URDF root link origin above the ground (world y = 0; the offset and the gait's bob
   /// come on top). Unset: automatic, so that the lowest collision point of the standing pose (the gait's
   /// standingAngles with `pose` applied) touches the ground; a root already on the ground stays at exactly 0.

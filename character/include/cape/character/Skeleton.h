@@ -29,10 +29,20 @@ struct WorldShape {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< the shape's frame in the world
 };
 
+/// Which world axis is up. Y: the world of docs/SCENES.md (y up, the character facing -Z at yaw 0). Z: the
+/// world of ROS and PyBullet (REP 103: x forward, y left, z up), which is that world turned by
+/// sceneToWorld(UpAxis::Z): a character at yaw 0 faces +X, and its URDF frame is the world's.
+enum class UpAxis : int { Y, Z };
+const char* toString(UpAxis up);
+
 class Skeleton {
  public:
-  /// The rotation taking URDF axes (x forward, y left, z up) into the world (x right, y up, z backward).
+  /// The rotation taking URDF axes (x forward, y left, z up) into the Y-up scene frame (x right, y up, z
+  /// backward).
   static Eigen::Matrix3d urdfToWorld();
+  /// The rotation taking the Y-up scene frame into a world with the given up axis: the identity for Y,
+  /// urdfToWorld()'s inverse for Z (scene +Y -> world +Z, scene -Z (forward) -> world +X).
+  static Eigen::Matrix3d sceneToWorld(UpAxis up);
 
   /// `model` must not be null. Joints start at rest (see restPosition), the root at the world origin, yaw 0.
   explicit Skeleton(UrdfModelPtr model);
@@ -78,6 +88,10 @@ class Skeleton {
   /// Any rigid character frame (the URDF-to-world rotation is applied inside it).
   void setRootTransform(const Eigen::Isometry3d& root);
   const Eigen::Isometry3d& rootTransform() const { return root_; }
+  /// The world's up axis (Y by default). The root (setRoot, setRootTransform) stays in the Y-up scene frame;
+  /// every pose this skeleton reports is turned by sceneToWorld(up) into the world.
+  void setUpAxis(UpAxis up);
+  UpAxis upAxis() const { return up_; }
 
   // --- Poses
   // ---------------------------------------------------------------------------------------------------
@@ -104,6 +118,7 @@ class Skeleton {
   double scale_ = 1.0;
   std::vector<double> q_;
   Eigen::Isometry3d root_ = Eigen::Isometry3d::Identity();
+  UpAxis up_ = UpAxis::Y;
   std::vector<std::vector<ShapeDesc>> shapes_;    ///< per link, scaled
   mutable std::vector<Eigen::Isometry3d> poses_;  ///< per link, world
   mutable bool dirty_ = true;

@@ -48,7 +48,7 @@ struct LinkDesc {
   int parentJoint = -1;  ///< index into UrdfModel::joints(); -1 for the root
   int parentLink = -1;   ///< index into UrdfModel::links(); -1 for the root
   std::vector<int> childJoints;
-  std::vector<ShapeDesc> shapes;  ///< collision elements (meshes left out, with a warning)
+  std::vector<ShapeDesc> shapes;  ///< collision elements that could be used (the others: warnings())
   double mass = 0.0;              ///< kg, from <inertial>; 0 when absent
 };
 
@@ -73,10 +73,26 @@ struct JointDesc {
 class UrdfModel;
 using UrdfModelPtr = std::shared_ptr<const UrdfModel>;
 
-/// What a load returns: ok and a model, or an error status and no model.
+/// How a URDF's mesh collision elements are found and made into hulls.
+struct UrdfLoadOptions {
+  /// Folder that relative mesh paths resolve against. fromFile uses the URDF file's folder when empty;
+  /// fromString the working directory.
+  std::string baseDir;
+  /// Where `package://NAME/path` looks: DIR/NAME/path, or DIR/path when DIR itself is the folder NAME, for
+  /// each DIR here, then for each entry of the ROS_PACKAGE_PATH environment variable.
+  std::vector<std::string> packagePaths;
+  /// Vertex budget of each mesh's simplified convex hull (>= 4).
+  int maxHullVertices = 64;
+  /// Off: mesh elements are skipped with a warning, no file is opened.
+  bool loadMeshes = true;
+};
+
+/// What a load returns: ok and a model, or an error status and no model. `warnings` holds what was said on
+/// the way, in order, also when the load failed (so the cause of a failure is not hidden).
 struct UrdfLoadResult {
   Status status;
   UrdfModelPtr model;
+  std::vector<std::string> warnings;
   bool ok() const { return status.ok() && model != nullptr; }
 };
 
@@ -84,9 +100,10 @@ struct UrdfLoadResult {
 class UrdfModel {
  public:
   /// Reads and parses a URDF file. FileNotFound when the path is not a readable regular file.
-  static UrdfLoadResult fromFile(const std::string& path);
-  /// Parses URDF text.
-  static UrdfLoadResult fromString(const std::string& xml);
+  static UrdfLoadResult fromFile(const std::string& path, const UrdfLoadOptions& options = {});
+  /// Parses URDF text. The text ends at its first NUL byte, as for Bullet's importer (PyBullet's humanoid
+  /// ships with one after </robot>).
+  static UrdfLoadResult fromString(const std::string& xml, const UrdfLoadOptions& options = {});
   /// The humanoid shipped in character/models/humanoid.urdf, compiled into the library (no file needed).
   static UrdfLoadResult humanoid();
   /// The text of that humanoid.

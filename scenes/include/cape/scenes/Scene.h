@@ -81,11 +81,17 @@ struct CapeRig {
   std::vector<std::uint32_t> pinnedParticles;  ///< Fabric particle indices
   std::vector<Vec3> pinLocalPoints;            ///< in the character frame, m
 };
-/// The canonical N x N cape (0.6 m x 1.0 m, 0.4 kg) with tethers to its attachment particles.
-CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings = true);
+/// A cape's size, m: the canonical 0.6 x 1.0 (docs/SCENES.md), or one fitted to a character.
+struct CapeSize {
+  float width = 0.6f;
+  float height = 1.0f;
+};
+/// The N x N cape (the canonical 0.6 m x 1.0 m, 0.4 kg; another size keeps its mass per area) with tethers
+/// to its attachment particles, its top row centred on the canonical pin line.
+CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings = true, const CapeSize& size = CapeSize());
 /// The cape's starting placement in the character frame: flat and vertical at z = 0.15 with its top row on
 /// the pins, or for "hang" flat and horizontal reaching from the pins towards +Z.
-Pose capeStartPlacement(SceneKind kind);
+Pose capeStartPlacement(SceneKind kind, const CapeSize& size = CapeSize());
 
 /// One cape on the simple body, stepped frame by frame: what tests and benchmarks run.
 class SimpleScene {
