@@ -124,13 +124,18 @@ GltfRecorder::GltfRecorder(int characters, double frameTime)
       tracks_(static_cast<std::size_t>(characters_)) {}
 
 void GltfRecorder::record(int character, const Cape& cape, const std::vector<Collider>& colliders) {
+  record(character, cape.fabric(), cape.state().positions, colliders);
+}
+
+void GltfRecorder::record(int character, const Fabric& fabric, const Points& positions,
+                          const std::vector<Collider>& colliders) {
   if (character < 0 || character >= characters_) return;
   if (character == 0) ++frames_;  // a new frame starts with character 0
   CharacterTrack& t = tracks_[static_cast<std::size_t>(character)];
   const bool first = t.vertices == 0;
   if (first) {
-    t.mesh.allocate(cape.fabric(), false);
-    t.vertices = cape.fabric().particleCount();
+    t.mesh.allocate(fabric, false);
+    t.vertices = fabric.particleCount();
     t.indices = t.mesh.indices;
     t.uvs.resize(t.vertices * 2);
     for (std::size_t i = 0; i < t.vertices; ++i) {
@@ -150,7 +155,7 @@ void GltfRecorder::record(int character, const Cape& cape, const std::vector<Col
     sceneMax_ = sceneMax_.cwiseMax(p.position);
   }
   // The cape: the first frame is the base mesh, every later frame a morph target of deltas from it.
-  t.mesh.update(cape.fabric(), cape.state().positions);
+  t.mesh.update(fabric, positions);
   const std::size_t n = t.vertices;
   if (first) {
     copyRows(t.mesh.positions, n, t.basePositions);

@@ -25,6 +25,10 @@ class GltfRecorder {
   /// is complete once every character has been recorded; characters come in order 0, 1, ... The colliders
   /// must be the same shapes in the same order in every frame (only their poses change).
   void record(int character, const Cape& cape, const std::vector<Collider>& colliders);
+  /// The same from a cape's fabric and particle positions (m; e.g. turned into glTF's Y-up from a Z-up
+  /// world).
+  void record(int character, const Fabric& fabric, const Points& positions,
+              const std::vector<Collider>& colliders);
 
   /// Frames recorded so far (complete or not).
   int frames() const { return frames_; }

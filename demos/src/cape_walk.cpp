@@ -21,7 +21,29 @@
 using namespace cape;
 using namespace cape::demo;
 
-namespace {}  // namespace
+namespace {
+
+// A cape and its colliders turned from a Z-up world into the Y-up scene frame, for glTF and the renderer.
+struct YUpView {
+  Points positions;
+  CapeMesh mesh;
+  std::vector<Collider> colliders;
+  void turn(const Cape& cape, const std::vector<Collider>& world, const Eigen::Matrix3f& toScene) {
+    positions = cape.state().positions * toScene.transpose();
+    if (mesh.positions.rows() == 0) mesh.allocate(cape.fabric(), false);
+    mesh.update(cape.fabric(), positions);
+    const Quat turn(toScene);
+    colliders = world;
+    for (Collider& c : colliders) {
+      for (Pose* p : {&c.previous, &c.current}) {
+        p->position = toScene * p->position;
+        p->rotation = (turn * p->rotation).normalized();
+      }
+    }
+  }
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -113,6 +135,8 @@ int main(int argc, char** argv) {
     }
   }
 
+  std::vector<YUpView> views(static_cast<std::size_t>(run->characterCount()));
+  const Eigen::Matrix3f toScene = character::Skeleton::sceneToWorld(o.up).transpose().cast<float>();
   std::vector<MetricsRecorder> recorders(static_cast<std::size_t>(run->characterCount()));
   std::vector<SelfIntersectionCounter> counters(recorders.size());
   std::vector<FrameRow> rows;
@@ -140,8 +164,16 @@ int main(int argc, char** argv) {
         lowest = std::min(lowest, static_cast<double>((run->cape(k).state().positions * up).minCoeff()));
       row.metrics = k == 0 ? m : worstOf(row.metrics, m);  // a crowd's row holds the worst of its characters
       writer->capeMesh(f, k, run->cape(k));
-      if (gltfRecorder) gltfRecorder->record(k, run->cape(k), colliders);
-      if (renderer) renderer->record(k, run->cape(k), colliders);
+      if (o.up == character::UpAxis::Y) {
+        if (gltfRecorder) gltfRecorder->record(k, run->cape(k), colliders);
+        if (renderer) renderer->record(k, run->cape(k), colliders);
+      } else if (gltfRecorder || renderer) {
+        // glTF and the renderer are Y-up: a Z-up world is turned back into the scene frame for them.
+        YUpView& v = views[static_cast<std::size_t>(k)];
+        v.turn(run->cape(k), colliders, toScene);
+        if (gltfRecorder) gltfRecorder->record(k, run->cape(k).fabric(), v.positions, v.colliders);
+        if (renderer) renderer->record(k, v.mesh, v.colliders);
+      }
       for (Collider c : colliders) {
         if (run->characterCount() > 1) c.name = "k" + std::to_string(k) + "/" + c.name;
         allColliders.push_back(std::move(c));
