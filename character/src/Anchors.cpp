@@ -141,8 +141,10 @@ ShoulderAnchors findShoulderAnchors(const Character& c) {
       a.left = points[0];
       a.right = points[1];
       finish(c, f, a);
-      a.description = "cape pinned to links '" + linkName(m, a.leftLink) + "' and '" +
-                      linkName(m, a.rightLink) + "' (the shoulders of the joint mapping: joints '" +
+      const std::string where = a.leftLink == a.rightLink ? "link '" + linkName(m, a.leftLink) + "'"
+                                                          : "links '" + linkName(m, a.leftLink) + "' and '" +
+                                                                linkName(m, a.rightLink) + "'";
+      a.description = "cape pinned to " + where + " (the shoulders of the joint mapping: joints '" +
                       m.joints()[static_cast<std::size_t>(roles[0])].name + "' and '" +
                       m.joints()[static_cast<std::size_t>(roles[1])].name + "')";
       return a;
