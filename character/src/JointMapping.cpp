@@ -116,6 +116,162 @@ bool saysPitch(const std::string& n) {
          contains(n, "_y_");
 }
 
+// --- Names as tokens: robot abbreviations (Atlas's l_leg_hpy, Hubo's LHP) ---
+
+struct Token {
+  std::string text;   // lower case
+  bool caps = false;  // written in capitals
+};
+
+// Splits a name at '_', '-', '.', digits and case changes: "LShoulderRoll" -> l shoulder roll, "l_leg_hpy" ->
+// l leg hpy, "LHP" -> lhp (capitals stay together), "LF11" -> lf.
+std::vector<Token> tokenize(const std::string& name) {
+  std::vector<Token> out;
+  std::string cur;
+  bool caps = true;
+  auto flush = [&]() {
+    if (!cur.empty()) out.push_back({lower(cur), caps});
+    cur.clear();
+    caps = true;
+  };
+  for (std::size_t i = 0; i < name.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(name[i]);
+    if (!std::isalpha(c)) {
+      flush();
+      continue;
+    }
+    const bool up = std::isupper(c) != 0;
+    if (!cur.empty()) {
+      const bool prevUp = std::isupper(static_cast<unsigned char>(cur.back())) != 0;
+      const bool nextLow = i + 1 < name.size() && std::islower(static_cast<unsigned char>(name[i + 1])) != 0;
+      if ((!prevUp && up) || (prevUp && up && nextLow)) flush();  // "leftShoulder", "LShoulder"
+    }
+    cur.push_back(static_cast<char>(c));
+    if (!up) caps = false;
+  }
+  flush();
+  return out;
+}
+
+// What a name says, read as tokens: its part (-1: none), side, and whether it says pitch or roll.
+struct NameInfo {
+  int part = -1;
+  int side = kNoSide;
+  bool pitch = false;
+  bool roll = false;
+};
+
+// An axis letter or word: 'p' pitch, 'r' roll, 'w' yaw, 0 none. Letters glued to a part (hpy, shx) and lone
+// letters are axes (x roll, y pitch, z yaw) or p / r.
+char axisOf(const std::string& t) {
+  if (t == "pitch" || t == "p" || t == "y" || t == "flex") return 'p';
+  if (t == "roll" || t == "r" || t == "x") return 'r';
+  if (t == "yaw" || t == "z") return 'w';
+  return 0;
+}
+
+int sideWord(const std::string& t) {
+  if (t == "l" || t == "left") return kLeft;
+  if (t == "r" || t == "right") return kRight;
+  return kNoSide;
+}
+
+// A part token: the word, or its two-letter abbreviation with or without one axis letter (hp, hpy, kn, kny,
+// ak, aky, sh, shx, el, elx). -1 if none.
+int partToken(const std::string& t, char& axis) {
+  struct Word {
+    const char* full;
+    const char* shortForm;
+  };
+  static const Word kWords[] = {
+      {"hip", "hp"}, {"knee", "kn"}, {"ankle", "ak"}, {"shoulder", "sh"}, {"elbow", "el"}};
+  axis = 0;
+  for (int part = 0; part < 5; ++part) {
+    const std::string shortForm = kWords[part].shortForm;
+    if (t == kWords[part].full || t == shortForm) return part;
+    if (t.size() == 3 && t.compare(0, 2, shortForm) == 0 &&
+        std::string("xyzpr").find(t[2]) != std::string::npos) {
+      axis = axisOf(std::string(1, t[2]));
+      return part;
+    }
+  }
+  return -1;
+}
+
+NameInfo tokenInfo(const std::string& name) {
+  NameInfo info;
+  const std::vector<Token> tokens = tokenize(name);
+  if (tokens.empty()) return info;
+  const int count = static_cast<int>(tokens.size());
+  int at = -1;
+  char axis = 0;
+  for (int i = 0; i < count && at < 0; ++i) {
+    const int part = partToken(tokens[static_cast<std::size_t>(i)].text, axis);
+    if (part >= 0) {
+      at = i;
+      info.part = part;
+    }
+  }
+  if (at < 0) {
+    // A short code in capitals leading the name: side, part letter, axis letter (LHP, LKP, LSR, LEP, RAR).
+    const Token& t = tokens.front();
+    static const std::string kLetters = "hkase";
+    if (!t.caps || t.text.size() < 2 || t.text.size() > 3 || sideWord(t.text.substr(0, 1)) == kNoSide)
+      return info;
+    const std::size_t part = kLetters.find(t.text[1]);
+    if (part == std::string::npos) return info;
+    if (t.text.size() == 3 && std::string("pry").find(t.text[2]) == std::string::npos) return info;
+    info.part = static_cast<int>(part);
+    info.side = sideWord(t.text.substr(0, 1));
+    const char a = t.text.size() == 3 ? t.text[2] : 0;  // a code's y is yaw
+    info.pitch = a == 'p';
+    info.roll = a == 'r';
+    return info;
+  }
+  // The side: a leading token, "left" or "right" anywhere, l / r right before the part, or a trailing one.
+  int sideAt = -1;
+  if (at > 0 && sideWord(tokens.front().text) != kNoSide) {
+    sideAt = 0;
+  } else {
+    for (int i = 0; i < count && sideAt < 0; ++i)
+      if (i != at && (tokens[static_cast<std::size_t>(i)].text == "left" ||
+                      tokens[static_cast<std::size_t>(i)].text == "right"))
+        sideAt = i;
+    if (sideAt < 0 && at > 0 && sideWord(tokens[static_cast<std::size_t>(at - 1)].text) != kNoSide)
+      sideAt = at - 1;
+    if (sideAt < 0 && count - 1 > at && sideWord(tokens.back().text) != kNoSide) sideAt = count - 1;
+  }
+  if (sideAt >= 0) info.side = sideWord(tokens[static_cast<std::size_t>(sideAt)].text);
+  for (int i = at + 1; i < count; ++i)
+    if (i != sideAt && axis == 0) axis = axisOf(tokens[static_cast<std::size_t>(i)].text);
+  info.pitch = axis == 'p';
+  info.roll = axis == 'r';
+  return info;
+}
+
+// Whether joint name `name` names `part` on `side`. The plain words first, as before (findPart, sideOf); a
+// name that says nothing that way is read as tokens.
+bool namesPart(const std::string& name, int part, int side) {
+  const std::string n = lower(name);
+  bool plain = false;
+  for (int p = 0; p < 5; ++p) {
+    const std::size_t at = findPart(n, p);
+    if (at == std::string::npos || sideOf(n, at) == kNoSide) continue;
+    if (p == part && sideOf(n, at) == side) return true;
+    plain = true;
+  }
+  if (plain) return false;
+  const NameInfo info = tokenInfo(name);
+  return info.part == part && info.side == side;
+}
+
+bool namesRoll(const std::string& name) {
+  return saysRoll(lower(name)) || tokenInfo(name).roll;
+}
+bool namesPitch(const std::string& name) {
+  return saysPitch(lower(name)) || tokenInfo(name).pitch;
+}
+
 // Links in the subtree under (and including) `link`.
 std::vector<int> subtree(const UrdfModel& m, int link) {
   std::vector<char> in(m.links().size(), 0);
@@ -131,8 +287,16 @@ std::vector<int> subtree(const UrdfModel& m, int link) {
   return out;
 }
 
-// Centroid of the link origins and shape centres of `links`, in the URDF root frame (the skeleton's root is
-// at the world origin with yaw 0, so undoing urdfToWorld is enough).
+// The mean of a hull's vertices, in its shape frame.
+Eigen::Vector3d hullCentre(const ShapeDesc& shape) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& v : shape.hull) mean += v;
+  return mean / static_cast<double>(shape.hull.size());
+}
+
+// Centroid of the link origins, shape centres and hull vertex centroids of `links`, in the URDF root frame
+// (the skeleton's root is at the world origin with yaw 0, so undoing urdfToWorld is enough). A mesh's hull
+// tells where a link is when its origin and its element's origin both sit on the joint (a foot).
 Eigen::Vector3d centroid(const Skeleton& s, const std::vector<int>& links) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int count = 0;
@@ -142,6 +306,9 @@ Eigen::Vector3d centroid(const Skeleton& s, const std::vector<int>& links) {
     ++count;
     for (const ShapeDesc& shape : s.shapes(l)) {
       sum += pose * shape.origin.translation();
+      ++count;
+      if (shape.hull.empty()) continue;
+      sum += pose * (shape.origin * hullCentre(shape));
       ++count;
     }
   }
@@ -239,12 +406,9 @@ std::vector<int> shoulderChain(const UrdfModel& m, int side) {
   std::vector<int> chain, elbows;
   for (std::size_t j = 0; j < joints.size(); ++j) {
     if (!isRotary(joints[j])) continue;
-    const std::string n = lower(joints[j].name);
-    for (int part : {kShoulder, kElbow}) {
-      const std::size_t at = findPart(n, part);
-      if (at != std::string::npos && sideOf(n, at) == side)
+    for (int part : {kShoulder, kElbow})
+      if (namesPart(joints[j].name, part, side))
         (part == kShoulder ? chain : elbows).push_back(static_cast<int>(j));
-    }
   }
   if (chain.empty()) return chain;
   // The first shoulder joint: the one nearest the root (its parent link comes first in link order).
@@ -281,7 +445,7 @@ int findShoulderRoll(const Skeleton& rest, int side, int exclude) {
     if (j == exclude) continue;
     const double forward = std::abs(axisInRoot(rest, j).x());
     if (forward < std::sqrt(0.5)) continue;
-    const bool named = saysRoll(lower(joints[static_cast<std::size_t>(j)].name));
+    const bool named = namesRoll(joints[static_cast<std::size_t>(j)].name);
     if (best < 0 || (named && !bestNamed) || (named == bestNamed && forward > bestForward + 1e-9)) {
       best = j;
       bestNamed = named;
@@ -297,6 +461,266 @@ void holdArms(const std::array<JointMapping::Entry, kGaitRoleCount>& entries, Sk
     const JointMapping::Entry& e = entries[static_cast<std::size_t>(role)];
     if (e.joint >= 0) (void)s.setJointPosition(e.joint, s.clampToLimits(e.joint, e.neutral));
   }
+}
+
+// --- Structure: the limbs from the kinematic tree and the rest pose ---
+
+// A link's points in the URDF root frame: its origin, its shapes' centres, its hulls' vertex centroids.
+void linkPoints(const Skeleton& s, int l, std::vector<Eigen::Vector3d>& out) {
+  out.clear();
+  const Eigen::Isometry3d& pose = s.linkPose(l);
+  out.push_back(pointInRoot(pose.translation()));
+  for (const ShapeDesc& shape : s.shapes(l)) {
+    out.push_back(pointInRoot(pose * shape.origin.translation()));
+    if (!shape.hull.empty()) out.push_back(pointInRoot(pose * (shape.origin * hullCentre(shape))));
+  }
+}
+
+// A limb: its revolute and continuous joints from the body outwards, and its end link (a foot, a hand).
+struct Limb {
+  std::vector<int> joints;
+  int end = -1;
+  std::string from;  // the link it hangs from, for what is said
+};
+struct Limbs {
+  std::array<Limb, 2> legs, arms;  // by side
+  int pelvis = -1;                 // where the legs meet; -1 when no legs were found
+};
+
+int commonAncestor(const UrdfModel& m, int a, int b) {
+  std::vector<int> up;
+  for (int l = a; l >= 0; l = m.links()[static_cast<std::size_t>(l)].parentLink) up.push_back(l);
+  for (int l = b; l >= 0; l = m.links()[static_cast<std::size_t>(l)].parentLink)
+    if (std::find(up.begin(), up.end(), l) != up.end()) return l;
+  return -1;
+}
+
+// The child of `top` on the way down to its descendant `bottom`.
+int childToward(const UrdfModel& m, int top, int bottom) {
+  int l = bottom;
+  while (l >= 0 && m.links()[static_cast<std::size_t>(l)].parentLink != top)
+    l = m.links()[static_cast<std::size_t>(l)].parentLink;
+  return l;
+}
+
+// The rotary joints on the way down from `top` to its descendant `bottom`, top first.
+std::vector<int> jointsDown(const UrdfModel& m, int top, int bottom) {
+  std::vector<int> out;
+  for (int l = bottom; l >= 0 && l != top; l = m.links()[static_cast<std::size_t>(l)].parentLink) {
+    const int j = m.links()[static_cast<std::size_t>(l)].parentJoint;
+    if (j >= 0 && isRotary(m.joints()[static_cast<std::size_t>(j)])) out.push_back(j);
+  }
+  std::reverse(out.begin(), out.end());
+  return out;
+}
+
+// Legs: the lowest link on each side (centre more than 2% of the height off the midline, its lowest point
+// within 10% of the height of the model's lowest), up to where the two meet (the pelvis), which must be no
+// higher than three quarters of the height. Arms: among the links of neither leg, those whose centres lie
+// farthest to the left and to the right, up to where the two meet (the chest), and down to the link beyond
+// farthest from the arm's first link (the hand). With three or more branches at the chest, the one reaching
+// highest is the head: it is no arm.
+Limbs findLimbs(const Skeleton& rest) {
+  const UrdfModel& m = rest.model();
+  const int n = rest.linkCount();
+  Limbs out;
+  std::vector<Eigen::Vector3d> centre(static_cast<std::size_t>(n)), points;
+  std::vector<double> low(static_cast<std::size_t>(n)), high(static_cast<std::size_t>(n));
+  double zMin = 0.0, zMax = 0.0;
+  for (int l = 0; l < n; ++l) {
+    linkPoints(rest, l, points);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double lo = points.front().z(), hi = lo;
+    for (const Eigen::Vector3d& p : points) {
+      sum += p;
+      lo = std::min(lo, p.z());
+      hi = std::max(hi, p.z());
+    }
+    const auto k = static_cast<std::size_t>(l);
+    centre[k] = sum / static_cast<double>(points.size());
+    low[k] = lo;
+    high[k] = hi;
+    zMin = l == 0 ? lo : std::min(zMin, lo);
+    zMax = l == 0 ? hi : std::max(zMax, hi);
+  }
+  const double height = zMax - zMin;
+  if (!(height > 1e-6)) return out;
+  auto sideOffset = [&](int l, int side) {
+    return side == kLeft ? centre[static_cast<std::size_t>(l)].y() : -centre[static_cast<std::size_t>(l)].y();
+  };
+  auto z = [&](int l) { return pointInRoot(rest.linkPose(l).translation()).z(); };
+  auto name = [&](int l) { return m.links()[static_cast<std::size_t>(l)].name; };
+
+  // Legs.
+  std::vector<char> taken(static_cast<std::size_t>(n), 0);
+  std::array<int, 2> foot{-1, -1};
+  for (int l = 0; l < n; ++l)
+    for (int side = kLeft; side <= kRight; ++side) {
+      int& f = foot[static_cast<std::size_t>(side)];
+      if (sideOffset(l, side) > 0.02 * height &&
+          (f < 0 || low[static_cast<std::size_t>(l)] < low[static_cast<std::size_t>(f)] - 1e-9))
+        f = l;
+    }
+  if (foot[0] >= 0 && foot[1] >= 0 &&
+      std::max(low[static_cast<std::size_t>(foot[0])], low[static_cast<std::size_t>(foot[1])]) <=
+          zMin + 0.1 * height) {
+    const int pelvis = commonAncestor(m, foot[0], foot[1]);
+    bool ok = pelvis >= 0 && pelvis != foot[0] && pelvis != foot[1];
+    std::array<Limb, 2> legs;
+    for (int side = kLeft; side <= kRight && ok; ++side) {
+      const int f = foot[static_cast<std::size_t>(side)];
+      const int top = childToward(m, pelvis, f);
+      Limb& leg = legs[static_cast<std::size_t>(side)];
+      leg.joints = jointsDown(m, pelvis, f);
+      leg.end = f;
+      leg.from = name(pelvis);
+      ok = !leg.joints.empty() && z(top) - zMin <= 0.75 * height;
+      for (int l : subtree(m, top)) taken[static_cast<std::size_t>(l)] = 1;
+    }
+    if (ok) {
+      out.legs = legs;
+      out.pelvis = pelvis;
+    } else {
+      std::fill(taken.begin(), taken.end(), 0);
+    }
+  }
+
+  // Arms.
+  auto extremes = [&]() {
+    std::array<int, 2> e{-1, -1};
+    for (int l = 0; l < n; ++l) {
+      if (taken[static_cast<std::size_t>(l)]) continue;
+      for (int side = kLeft; side <= kRight; ++side) {
+        int& x = e[static_cast<std::size_t>(side)];
+        if (sideOffset(l, side) > 0.02 * height &&
+            (x < 0 || sideOffset(l, side) > sideOffset(x, side) + 1e-9))
+          x = l;
+      }
+    }
+    return e;
+  };
+  std::array<int, 2> hand = extremes();
+  if (hand[0] < 0 || hand[1] < 0) return out;
+  int chest = commonAncestor(m, hand[0], hand[1]);
+  if (chest < 0) return out;
+  std::vector<int> branches;
+  for (int j : m.links()[static_cast<std::size_t>(chest)].childJoints) {
+    const int c = m.joints()[static_cast<std::size_t>(j)].childLink;
+    if (!taken[static_cast<std::size_t>(c)]) branches.push_back(c);
+  }
+  if (branches.size() >= 3) {
+    int head = -1;
+    double top = 0.0;
+    for (int b : branches) {
+      double reach = high[static_cast<std::size_t>(b)];
+      for (int l : subtree(m, b)) reach = std::max(reach, high[static_cast<std::size_t>(l)]);
+      if (head < 0 || reach > top) {
+        head = b;
+        top = reach;
+      }
+    }
+    const std::vector<int> headLinks = subtree(m, head);
+    auto inHead = [&](int l) { return std::find(headLinks.begin(), headLinks.end(), l) != headLinks.end(); };
+    if (inHead(hand[0]) || inHead(hand[1])) {
+      for (int l : headLinks) taken[static_cast<std::size_t>(l)] = 1;
+      hand = extremes();
+      if (hand[0] < 0 || hand[1] < 0) return out;
+      chest = commonAncestor(m, hand[0], hand[1]);
+    }
+  }
+  if (chest < 0 || chest == hand[0] || chest == hand[1]) return out;
+  std::array<Limb, 2> arms;
+  for (int side = kLeft; side <= kRight; ++side) {
+    const int top = childToward(m, chest, hand[static_cast<std::size_t>(side)]);
+    // The hand: the link beyond the arm's first one farthest from it.
+    const Eigen::Vector3d start = pointInRoot(rest.linkPose(top).translation());
+    int end = top;
+    for (int l : subtree(m, top))
+      if ((centre[static_cast<std::size_t>(l)] - start).norm() >
+          (centre[static_cast<std::size_t>(end)] - start).norm() + 1e-9)
+        end = l;
+    Limb& arm = arms[static_cast<std::size_t>(side)];
+    arm.joints = jointsDown(m, chest, end);
+    arm.end = end;
+    arm.from = name(chest);
+    // An arm leaves the upper body: above the pelvis, when there are legs.
+    if (arm.joints.empty() || (out.pelvis >= 0 && z(top) <= z(out.pelvis))) return out;
+  }
+  out.arms = arms;
+  return out;
+}
+
+// The shoulder roll of one side's arm by structure: among the arm's first three joints, those with a forward
+// axis (URDF x, at least cos 45 degrees), the one that hangs the arm nearest straight down (the first of
+// those within 0.05 rad of the best). -1 if none.
+int rollByStructure(const Skeleton& rest, const std::vector<int>& arm, int side) {
+  int best = -1;
+  double bestResidual = 0.0;
+  for (std::size_t k = 0; k < arm.size() && k < 3; ++k) {
+    const int j = arm[k];
+    if (std::abs(axisInRoot(rest, j).x()) < std::sqrt(0.5)) continue;
+    const ArmHold h = armHold(rest, j, side);
+    if (!h.ok) continue;
+    if (best < 0 || h.residual < bestResidual - 0.05) {
+      best = j;
+      bestResidual = h.residual;
+    }
+  }
+  return best;
+}
+
+// Joint origin in the URDF root frame (the skeleton's root at the world origin, yaw 0).
+Eigen::Vector3d jointOrigin(const Skeleton& s, int joint) {
+  return pointInRoot(s.linkPose(s.model().joints()[static_cast<std::size_t>(joint)].childLink).translation());
+}
+
+// The farthest point beyond a joint (link origins, shape centres, hull centroids of its subtree): its link
+// and where it lies in that link's frame. For telling a bend from a stretch.
+std::pair<int, Eigen::Vector3d> farthestBeyond(const Skeleton& s, int joint) {
+  const JointDesc& j = s.model().joints()[static_cast<std::size_t>(joint)];
+  const Eigen::Vector3d origin = jointOrigin(s, joint);
+  std::pair<int, Eigen::Vector3d> best{j.childLink, Eigen::Vector3d::Zero()};
+  double far = 0.0;
+  std::vector<Eigen::Vector3d> points;
+  for (int l : subtree(s.model(), j.childLink)) {
+    linkPoints(s, l, points);
+    const Eigen::Isometry3d toLink = s.linkPose(l).inverse();
+    for (const Eigen::Vector3d& p : points) {
+      const double d = (p - origin).norm();
+      if (d > far) {
+        far = d;
+        best = {l, toLink * (Skeleton::urdfToWorld() * p)};
+      }
+    }
+  }
+  return best;
+}
+
+// +1 if turning `joint` from q- to q+ brings the farthest point beyond it nearer the first link origin above
+// it at least 2 cm away (a bend), -1 if farther, 0 if neither clearly (less than 0.3 of the point's motion).
+// `pose(joint, q)` puts the skeleton in the probing pose with the joint at q.
+template <class Pose>
+double bendSign(const UrdfModelPtr& model, int joint, double qPlus, double qMinus, Pose& pose, Skeleton& s) {
+  const JointDesc& j = model->joints()[static_cast<std::size_t>(joint)];
+  pose(joint, s.restPosition(joint));
+  const Eigen::Vector3d at = jointOrigin(s, joint);
+  int above = j.parentLink;
+  while (above >= 0 && (pointInRoot(s.linkPose(above).translation()) - at).norm() < 0.02)
+    above = model->links()[static_cast<std::size_t>(above)].parentLink;
+  if (above < 0) return 0.0;
+  const auto [link, local] = farthestBeyond(s, joint);
+  auto place = [&](double q, Eigen::Vector3d& end, Eigen::Vector3d& top) {
+    pose(joint, q);
+    end = pointInRoot(s.linkPose(link) * local);
+    top = pointInRoot(s.linkPose(above).translation());
+  };
+  Eigen::Vector3d endPlus, topPlus, endMinus, topMinus;
+  place(qPlus, endPlus, topPlus);
+  place(qMinus, endMinus, topMinus);
+  const double change = (endPlus - topPlus).norm() - (endMinus - topMinus).norm();
+  const double motion = (endPlus - endMinus).norm();
+  if (motion < 1e-9 || std::abs(change) < 0.3 * motion) return 0.0;
+  return change < 0.0 ? 1.0 : -1.0;
 }
 
 }  // namespace
@@ -331,48 +755,162 @@ JointMapping JointMapping::fromNames(const UrdfModelPtr& model,
 }
 
 JointMapping JointMapping::byCommonNames(const UrdfModelPtr& model) {
+  return build(model, true, false);
+}
+
+JointMapping JointMapping::byStructure(const UrdfModelPtr& model) {
+  return build(model, false, true);
+}
+
+JointMapping JointMapping::build(const UrdfModelPtr& model, bool byName, bool byTree) {
   JointMapping m;
   const Skeleton rest(model);
   const auto& joints = model->joints();
+  const Limbs limbs = byTree ? findLimbs(rest) : Limbs();
+  std::array<std::string, kGaitRoleCount> byStructureSaid{}, noCandidate{};
+  auto entry = [&](int part, int side) -> Entry& {
+    return m.entries_[static_cast<std::size_t>(roleOf(part, side))];
+  };
+  auto used = [&](int j) {
+    return std::any_of(m.entries_.begin(), m.entries_.end(), [&](const Entry& e) { return e.joint == j; });
+  };
+  auto limbName = [&](const Limb& limb, bool leg, int side) {
+    return std::string(side == kLeft ? "left " : "right ") + (leg ? "leg" : "arm") + " '" + limb.from +
+           "' to '" + model->links()[static_cast<std::size_t>(limb.end)].name + "': ";
+  };
+
   // Shoulder rolls first, and their arms-down pose, in which the other joints are chosen.
   for (int side = kLeft; side <= kRight; ++side) {
-    Entry& e = m.entries_[static_cast<std::size_t>(roleOf(kRollPart, side))];
-    e.joint = findShoulderRoll(rest, side, -1);
+    Entry& e = entry(kRollPart, side);
+    if (byName) e.joint = findShoulderRoll(rest, side, -1);
+    const Limb& arm = limbs.arms[static_cast<std::size_t>(side)];
+    if (e.joint < 0 && arm.end >= 0) {
+      e.joint = rollByStructure(rest, arm.joints, side);
+      if (e.joint >= 0)
+        byStructureSaid[static_cast<std::size_t>(roleOf(kRollPart, side))] =
+            limbName(arm, false, side) +
+            "the joint among its first three with a forward axis that hangs it nearest straight down";
+    }
     if (e.joint >= 0) e.neutral = armHold(rest, e.joint, side).neutral;
   }
   Skeleton held(model);
   holdArms(m.entries_, held);
-  for (int part = 0; part < 5; ++part) {
-    for (int side = kLeft; side <= kRight; ++side) {
-      const auto role = roleOf(part, side);
-      int best = -1;
-      double bestLateral = -1.0;
-      bool bestPitch = false;
-      std::string candidates;
-      for (std::size_t j = 0; j < joints.size(); ++j) {
-        if (!isRotary(joints[j])) continue;
-        const int ji = static_cast<int>(j);
-        if (ji == m[GaitRole::LeftShoulderRoll].joint || ji == m[GaitRole::RightShoulderRoll].joint) continue;
-        const std::string n = lower(joints[j].name);
-        const std::size_t at = findPart(n, part);
-        if (at == std::string::npos || sideOf(n, at) != side) continue;
-        // Side to side is URDF y. Several joints for one part (roll, pitch, yaw): take the pitch-like one.
-        const double lateral = std::abs(axisInRoot(held, ji).y());
-        const bool pitch = saysPitch(n);
-        candidates += (candidates.empty() ? "" : ", ") + joints[j].name;
-        if (lateral > bestLateral + 1e-6 || (lateral > bestLateral - 1e-6 && pitch && !bestPitch)) {
-          bestLateral = lateral;
-          bestPitch = pitch;
-          best = ji;
+
+  if (byName) {
+    for (int part = 0; part < 5; ++part) {
+      for (int side = kLeft; side <= kRight; ++side) {
+        const auto role = roleOf(part, side);
+        int best = -1;
+        double bestLateral = -1.0;
+        bool bestPitch = false;
+        std::string candidates;
+        for (std::size_t j = 0; j < joints.size(); ++j) {
+          if (!isRotary(joints[j])) continue;
+          const int ji = static_cast<int>(j);
+          if (ji == m[GaitRole::LeftShoulderRoll].joint || ji == m[GaitRole::RightShoulderRoll].joint)
+            continue;
+          if (!namesPart(joints[j].name, part, side)) continue;
+          // Side to side is URDF y. Several joints for one part (roll, pitch, yaw): take the pitch-like one.
+          const double lateral = std::abs(axisInRoot(held, ji).y());
+          const bool pitch = namesPitch(joints[j].name);
+          candidates += (candidates.empty() ? "" : ", ") + joints[j].name;
+          if (lateral > bestLateral + 1e-6 || (lateral > bestLateral - 1e-6 && pitch && !bestPitch)) {
+            bestLateral = lateral;
+            bestPitch = pitch;
+            best = ji;
+          }
+        }
+        if (best >= 0 && bestLateral < 0.5) {
+          noCandidate[static_cast<std::size_t>(role)] = std::string(toString(role)) +
+                                                        ": no candidate turns about the side-to-side axis (" +
+                                                        candidates + ")";
+          best = -1;
+        }
+        m.entries_[static_cast<std::size_t>(role)].joint = best;
+      }
+    }
+  }
+
+  // Structure fills what the names left: in each limb, role after role from the body outwards, the next
+  // side-to-side joint beyond the previous role's joint (and before the next role's, if that one is mapped).
+  auto lateral = [&](int j) { return std::abs(axisInRoot(held, j).y()) > 0.7; };
+  auto fill = [&](const Limb& limb, const std::vector<int>& parts, int side, bool leg) {
+    const std::vector<int>& chain = limb.joints;
+    const int size = static_cast<int>(chain.size());
+    auto posOf = [&](int j) {
+      const auto it = std::find(chain.begin(), chain.end(), j);
+      return it == chain.end() ? -1 : static_cast<int>(it - chain.begin());
+    };
+    int from = 0;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      Entry& e = entry(parts[i], side);
+      if (e.joint >= 0) {
+        if (posOf(e.joint) >= 0) from = posOf(e.joint) + 1;
+        continue;
+      }
+      int to = size;
+      for (std::size_t k = i + 1; k < parts.size(); ++k) {
+        const int p = posOf(entry(parts[k], side).joint);
+        if (p >= 0) {
+          to = p;
+          break;
         }
       }
-      if (best >= 0 && bestLateral < 0.5) {
-        m.warnings_.push_back(std::string(toString(role)) +
-                              ": no candidate turns about the side-to-side axis (" + candidates + ")");
-        best = -1;
+      std::string how;
+      for (int k = from; k < to && e.joint < 0; ++k) {
+        if (used(chain[static_cast<std::size_t>(k)]) || !lateral(chain[static_cast<std::size_t>(k)]))
+          continue;
+        e.joint = chain[static_cast<std::size_t>(k)];
+        from = k + 1;
+        static const char* const kWhich[] = {
+            "its first side-to-side joint", "the next side-to-side joint beyond the hip",
+            "the next side-to-side joint beyond the knee", "its first side-to-side joint, arms down",
+            "the next side-to-side joint beyond the shoulder"};
+        how = limbName(limb, leg, side) + kWhich[parts[i]];
       }
-      m.entries_[static_cast<std::size_t>(role)].joint = best;
+      if (e.joint < 0 && parts[i] == kElbow) {
+        // A bent or T-pose arm: the first joint beyond the shoulder, away from it, that turns across the
+        // upper arm (the way in from the last joint before it elsewhere) and across what it moves.
+        const int shoulder = entry(kShoulder, side).joint;
+        const Eigen::Vector3d top = jointOrigin(held, shoulder >= 0 ? shoulder : chain.front());
+        const double length = (pointInRoot(held.linkPose(limb.end).translation()) - top).norm();
+        for (int k = from; k < to && e.joint < 0 && length > 1e-6; ++k) {
+          const int j = chain[static_cast<std::size_t>(k)];
+          if (used(j)) continue;
+          const Eigen::Vector3d at = jointOrigin(held, j);
+          Eigen::Vector3d in = Eigen::Vector3d::Zero();
+          for (int b = k - 1; b >= 0 && in.norm() < 0.01; --b)
+            in = at - jointOrigin(held, chain[static_cast<std::size_t>(b)]);
+          const Eigen::Vector3d out = armBeyond(held, j), axis = axisInRoot(held, j).normalized();
+          if ((at - top).norm() < 0.2 * length || in.norm() < 0.01 || out.norm() < 0.2 * length) continue;
+          if (std::abs(axis.dot(in.normalized())) > 0.5 || std::abs(axis.dot(out.normalized())) > 0.5)
+            continue;
+          e.joint = j;
+          from = k + 1;
+          how = limbName(limb, leg, side) +
+                "the first joint beyond the shoulder turning across the upper arm and the forearm";
+        }
+      }
+      if (e.joint >= 0) byStructureSaid[static_cast<std::size_t>(roleOf(parts[i], side))] = how;
     }
+  };
+  for (int side = kLeft; side <= kRight; ++side) {
+    if (limbs.legs[static_cast<std::size_t>(side)].end >= 0)
+      fill(limbs.legs[static_cast<std::size_t>(side)], {0, 1, 2}, side, true);
+    if (limbs.arms[static_cast<std::size_t>(side)].end >= 0)
+      fill(limbs.arms[static_cast<std::size_t>(side)], {kShoulder, kElbow}, side, false);
+  }
+
+  for (int r = 0; r < kGaitRoleCount; ++r) {
+    const auto k = static_cast<std::size_t>(r);
+    if (!noCandidate[k].empty() && m.entries_[k].joint < 0) m.warnings_.push_back(noCandidate[k]);
+  }
+  for (int r = 0; r < kGaitRoleCount; ++r) {
+    const auto k = static_cast<std::size_t>(r);
+    if (byStructureSaid[k].empty() || m.entries_[k].joint < 0) continue;
+    m.warnings_.push_back(std::string(toString(static_cast<GaitRole>(r))) + ": joint '" +
+                          joints[static_cast<std::size_t>(m.entries_[k].joint)].name + "' (by structure, " +
+                          byStructureSaid[k] + ")");
   }
   m.finish(model);
   return m;
@@ -382,7 +920,7 @@ JointMapping JointMapping::automatic(const UrdfModelPtr& model) {
   auto names = shippedHumanoidNames();
   const bool all = std::all_of(names.begin(), names.end(),
                                [&](const std::string& n) { return n.empty() || model->findJoint(n) >= 0; });
-  if (!all) return byCommonNames(model);
+  if (!all) return build(model, true, true);
   const Skeleton rest(model);
   for (int side = kLeft; side <= kRight; ++side) {
     const int shoulder = model->findJoint(names[static_cast<std::size_t>(roleOf(kShoulder, side))]);
@@ -444,9 +982,28 @@ void JointMapping::finish(const UrdfModelPtr& model) {
     pose(e.joint, qMinus);
     const Eigen::Vector3d d = centroid(probe, moved) - cPlus;  // motion from q+ to q-: the negative direction
     if (qPlus <= qMinus || d.norm() < 1e-9 || std::abs(d.x()) < 0.3 * d.norm()) {
-      warnings_.push_back(std::string(toString(role)) + ": cannot tell which way joint '" + j.name +
-                          "' turns (its links do not move forward or backward); assuming positive");
-      e.sign = 1.0;
+      // A knee or an elbow bends: the way that brings the limb's end nearer the link above the joint (a bent
+      // arm), else the way its limits let it turn (one way only: an arm bending sideways).
+      const bool bends = role == GaitRole::LeftKnee || role == GaitRole::RightKnee ||
+                         role == GaitRole::LeftElbow || role == GaitRole::RightElbow;
+      double sign = 0.0;
+      if (bends && qPlus > qMinus) sign = bendSign(model, e.joint, qPlus, qMinus, pose, probe);
+      if (bends && sign == 0.0 && j.hasLimits) {
+        const double up = j.upper - rest, down = rest - j.lower;
+        if (std::max(up, down) > 0.5 && std::min(up, down) < 0.25 * std::max(up, down)) {
+          sign = up > down ? 1.0 : -1.0;
+          warnings_.push_back(
+              std::string(toString(role)) + ": joint '" + j.name +
+              "' moves its links neither forward nor backward; signed by its limits (it turns " +
+              (sign > 0.0 ? "positive" : "negative") + " from rest)");
+        }
+      }
+      if (sign == 0.0) {
+        warnings_.push_back(std::string(toString(role)) + ": cannot tell which way joint '" + j.name +
+                            "' turns (its links do not move forward or backward); assuming positive");
+        sign = 1.0;
+      }
+      e.sign = sign;
       continue;
     }
     const double forwardPerPositive = d.x() < 0.0 ? 1.0 : -1.0;  // d is the motion for decreasing q
