@@ -1,6 +1,9 @@
 // Loading a URDF with urdfdom into the plain data of Urdf.h, with every failure turned into a Status.
 #include "cape/character/Urdf.h"
 
+#include "cape/character/Anchors.h"
+#include "cape/character/Skeleton.h"
+
 #include "UrdfGeometry.h"
 #include "XmlOutline.h"
 
@@ -10,6 +13,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -257,6 +261,42 @@ struct UrdfModelBuilder {
     return Status::success();
   }
 
+  // A model that stands along its y axis turned onto z (REP 103), by turning what hangs below the root link
+  // (its shapes and its child joints' origins) +90 degrees about x: y -> z, z -> -y, x stays forward.
+  static void standUp(UrdfModel& model, UrdfLoadOptions::Up up) {
+    if (up == UrdfLoadOptions::Up::Auto) {
+      const auto zeroPose = std::make_shared<const UrdfModel>(model);
+      const Skeleton probe(zeroPose);
+      Eigen::AlignedBox3d box;
+      const Eigen::Matrix3d toUrdf = Skeleton::urdfToWorld().transpose();
+      for (const WorldShape& w : probe.worldShapes()) {
+        Eigen::Isometry3d p = w.pose;
+        p.linear() = toUrdf * p.linear();
+        p.translation() = toUrdf * p.translation();
+        box.extend(shapeBounds(*w.shape, p));
+      }
+      if (box.isEmpty() || !(box.sizes().y() > 2.0 * box.sizes().z())) return;
+      // Only said: an upper body in a T-pose is long along y too, and turning it would be wrong.
+      char line[240];
+      std::snprintf(
+          line, sizeof line,
+          "the model is %.2f m long along y and %.2f m along z in its zero pose: if it stands along "
+          "y (a Y-up model), load it with UrdfLoadOptions::modelUp = Y (cape_walk --model-up y)",
+          box.sizes().y(), box.sizes().z());
+      model.warnings_.push_back(line);
+      return;
+    }
+    if (up == UrdfLoadOptions::Up::Z) {
+      return;
+    }
+    const Eigen::Isometry3d turn(Eigen::AngleAxisd(0.5 * 3.14159265358979323846, Eigen::Vector3d::UnitX()));
+    for (ShapeDesc& shape : model.links_[0].shapes) shape.origin = turn * shape.origin;
+    for (int j : model.links_[0].childJoints) {
+      JointDesc& joint = model.joints_[static_cast<std::size_t>(j)];
+      joint.origin = turn * joint.origin;
+    }
+  }
+
   static Status readJoint(const urdf::Joint& src, JointDesc& joint) {
     switch (src.type) {
       case urdf::Joint::REVOLUTE:
@@ -381,6 +421,7 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xmlIn, const UrdfLoadOpt
   }
   release(parsed);
   if (result.status.ok()) {
+    UrdfModelBuilder::standUp(*model, options.modelUp);
     result.model = std::move(model);
     result.warnings = result.model->warnings();
   }

@@ -147,6 +147,7 @@ void BulletScene::makeWorld(WorldKind kind) {
 bool BulletScene::loadModel(const RunOptions& o, std::string& error) {
   character::UrdfLoadOptions load;
   load.packagePaths = o.packagePaths;
+  load.modelUp = o.modelUp;
   const character::UrdfLoadResult loaded =
       o.urdf.empty() ? character::UrdfModel::humanoid() : character::UrdfModel::fromFile(o.urdf, load);
   warnings_ = loaded.warnings;  // also when the load failed: they may say why
@@ -184,6 +185,7 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
   cs.up = options_.up;
   cs.rootHeight = options_.rootHeight;
   cs.pose = options_.pose;
+  cs.scale = options_.scale;
   character::CharacterResult made =
       character::Character::create(model_, *world_, character::Gait::forScene(options_.scene), cs);
   if (!made.ok()) {
@@ -193,9 +195,26 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
   c->urdf = std::move(made.character);
   for (const character::WorldShape& w : c->urdf->skeleton().worldShapes())
     c->hulls.push_back(w.shape->type == character::ShapeType::ConvexHull ? hullOf(*w.shape) : nullptr);
-  if (first)
+  if (first) {
     for (const std::string& w : c->urdf->warnings())
       if (std::find(warnings_.begin(), warnings_.end(), w) == warnings_.end()) warnings_.push_back(w);
+    // A humanoid far taller or shorter than people and robots are may not be in metres.
+    Eigen::AlignedBox3d box;
+    const Eigen::Matrix3d toScene = character::Skeleton::sceneToWorld(options_.up).transpose();
+    for (const character::WorldShape& w : c->urdf->skeleton().worldShapes()) {
+      Eigen::Isometry3d p = w.pose;
+      p.linear() = toScene * p.linear();
+      p.translation() = toScene * p.translation();
+      box.extend(character::shapeBounds(*w.shape, p));
+    }
+    if (!box.isEmpty() && (box.max().y() > 3.0 || box.max().y() < 0.3)) {
+      char line[160];
+      std::snprintf(line, sizeof line,
+                    "the character is %.2f m tall: if its file is not in metres, scale it (--scale)",
+                    box.max().y());
+      warnings_.push_back(line);
+    }
+  }
 
   // Where the cape hangs: on the links asked for, or on the shoulders the joint mapping found.
   const character::ShoulderAnchors a =

@@ -37,6 +37,15 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
   app.add_option("--root-height", cli.rootHeight,
                  "height of the URDF's root link above the ground, m (default: its lowest collision point "
                  "touches the ground)");
+  app.add_option("--model-up", cli.modelUp,
+                 "the axis the URDF model stands along in its file: auto (z, with a warning when it looks "
+                 "Y-up) | z (REP 103) | y (Y-up tools, e.g. PyBullet's DeepMimic humanoid)")
+      ->check(CLI::IsMember({"auto", "z", "y"}))
+      ->capture_default_str();
+  app.add_option("--scale", cli.scale,
+                 "uniform scale of the URDF model (e.g. 0.25 for a model in other units)")
+      ->check(CLI::Range(1e-3, 1e3))
+      ->capture_default_str();
   app.add_option("--pose", cli.pose,
                  "starting joint positions, rad (or m): name=value,name=value; the gait moves from there");
 }
@@ -46,6 +55,10 @@ bool toRunOptions(const SceneCli& cli, RunOptions& o, std::string& error) {
   o.packagePaths = cli.packagePaths;
   o.up = cli.up == "z" ? character::UpAxis::Z : character::UpAxis::Y;
   o.rootHeight = cli.rootHeight;
+  o.modelUp = cli.modelUp == "y"   ? character::UrdfLoadOptions::Up::Y
+              : cli.modelUp == "z" ? character::UrdfLoadOptions::Up::Z
+                                   : character::UrdfLoadOptions::Up::Auto;
+  o.scale = cli.scale;
   if (!cli.pose.empty()) {
     const character::Status s = character::parsePose(cli.pose, o.pose);
     if (!s.ok()) {

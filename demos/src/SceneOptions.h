@@ -24,10 +24,12 @@ struct SceneCli {
   std::string up = "y";
   std::optional<double> rootHeight;
   std::string pose;  ///< name=rad,name=rad,...
+  std::string modelUp = "auto";
+  double scale = 1.0;
 };
 
 /// Adds --scene, --size, --attachment, --seconds, --characters, --simple-body, --urdf, --attach,
-/// --package-path, --up, --root-height and --pose.
+/// --package-path, --up, --root-height, --pose, --model-up and --scale.
 void addSceneOptions(CLI::App& app, SceneCli& cli);
 
 /// The run options they ask for (the attachment links split at commas; one character unless the crowd).

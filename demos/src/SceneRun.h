@@ -3,6 +3,7 @@
 #pragma once
 
 #include "cape/character/Skeleton.h"
+#include "cape/character/Urdf.h"
 #include "cape/scenes/Metrics.h"
 #include "cape/scenes/Scene.h"
 
@@ -31,6 +32,8 @@ struct RunOptions {
   character::UpAxis up = character::UpAxis::Y;       ///< the world's up axis
   std::optional<double> rootHeight;                  ///< m; empty: the character stands on the ground
   std::vector<std::pair<std::string, double>> pose;  ///< the character's starting joint positions by name
+  character::UrdfLoadOptions::Up modelUp = character::UrdfLoadOptions::Up::Auto;  ///< the model's own up
+  double scale = 1.0;                                                             ///< of the URDF model
 };
 
 class SceneRun {

@@ -392,6 +392,44 @@ TEST(Urdf, SphericalJointsAreReadAsHeldJointsWithAWarning) {
   EXPECT_NE(r.warnings[0].find("'ball'"), std::string::npos) << r.warnings[0];
 }
 
+TEST(Urdf, AModelStandingAlongYIsTurnedOntoZ) {
+  // A stick figure standing along y (as Y-up tools write them): a 0.3 m wide body, 1.6 m tall.
+  const std::string xml = R"(<robot name="yup"><link name="pelvis">
+        <collision><origin xyz="0 0.5 0"/><geometry><box size="0.2 1.0 0.3"/></geometry></collision></link>
+      <link name="head"><collision><geometry><sphere radius="0.1"/></geometry></collision></link>
+      <joint name="neck" type="revolute"><parent link="pelvis"/><child link="head"/><origin xyz="0 1.5 0"/>
+        <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>)";
+  // Auto: said, not turned (an upper body in a T-pose looks the same).
+  const UrdfLoadResult said = UrdfModel::fromString(xml);
+  ASSERT_TRUE(said.ok()) << said.status.message();
+  ASSERT_EQ(said.warnings.size(), 1u);
+  EXPECT_NE(said.warnings[0].find("--model-up y"), std::string::npos) << said.warnings[0];
+  EXPECT_TRUE(
+      jointNamed(*said.model, "neck").origin.translation().isApprox(Eigen::Vector3d(0, 1.5, 0), 1e-12));
+  UrdfLoadOptions y;
+  y.modelUp = UrdfLoadOptions::Up::Y;
+  const UrdfLoadResult automatic = UrdfModel::fromString(xml, y);
+  ASSERT_TRUE(automatic.ok()) << automatic.status.message();
+  EXPECT_TRUE(automatic.warnings.empty());
+  // The neck now rises along z, its axis (z, side to side in the file) is now -y in the root's frame, and
+  // the body box stands along z.
+  const JointDesc& neck = jointNamed(*automatic.model, "neck");
+  EXPECT_TRUE(neck.origin.translation().isApprox(Eigen::Vector3d(0, 0, 1.5), 1e-12));
+  EXPECT_TRUE((neck.origin.linear() * neck.axis).isApprox(Eigen::Vector3d(0, -1, 0), 1e-12));
+  EXPECT_TRUE(
+      automatic.model->links()[0].shapes[0].origin.translation().isApprox(Eigen::Vector3d(0, 0, 0.5), 1e-12));
+  // Told z: the file's frame, and no warning.
+  UrdfLoadOptions z;
+  z.modelUp = UrdfLoadOptions::Up::Z;
+  const UrdfLoadResult kept = UrdfModel::fromString(xml, z);
+  ASSERT_TRUE(kept.ok());
+  EXPECT_TRUE(kept.warnings.empty());
+  EXPECT_TRUE(
+      jointNamed(*kept.model, "neck").origin.translation().isApprox(Eigen::Vector3d(0, 1.5, 0), 1e-12));
+  // The shipped humanoid stands along z: nothing is turned.
+  EXPECT_TRUE(UrdfModel::humanoid().warnings.empty());
+}
+
 TEST(Urdf, XmlCheckAcceptsOrdinaryDocuments) {
   std::string msg;
   EXPECT_TRUE(

@@ -85,6 +85,13 @@ struct UrdfLoadOptions {
   int maxHullVertices = 64;
   /// Off: mesh elements are skipped with a warning, no file is opened.
   bool loadMeshes = true;
+  /// The axis the model stands along in its own file. REP 103 says z; models from Y-up tools (PyBullet's
+  /// DeepMimic humanoid) stand along y, with x forward, and are turned here onto z (a +90 degree turn about
+  /// x of everything below the root link). Auto: z, with a warning suggesting Y when the model in its zero
+  /// pose is more than twice as long along y as along z (a Y-up humanoid; but also an upper body in a
+  /// T-pose, so nothing is turned unless asked).
+  enum class Up : int { Auto, Z, Y };
+  Up modelUp = Up::Auto;
 };
 
 /// What a load returns: ok and a model, or an error status and no model. `warnings` holds what was said on
