@@ -7,40 +7,6 @@
 
 namespace cape::character {
 
-Eigen::AlignedBox3d shapeBounds(const ShapeDesc& s, const Eigen::Isometry3d& pose) {
-  const Eigen::Matrix3d r = pose.linear();
-  const Eigen::Vector3d c = pose.translation();
-  Eigen::Vector3d half = Eigen::Vector3d::Zero();
-  switch (s.type) {
-    case ShapeType::Sphere:
-      half.setConstant(s.radius);
-      break;
-    case ShapeType::Box:
-      half = r.cwiseAbs() * s.halfExtents;
-      break;
-    case ShapeType::Cylinder:
-    case ShapeType::Capsule: {
-      // Along each world axis k: the axis' reach |a_k| h, plus the rim's r sqrt(1 - a_k^2) for a cylinder or
-      // the end spheres' r for a capsule.
-      const Eigen::Vector3d a = r.col(2);
-      for (int k = 0; k < 3; ++k) {
-        const double rim =
-            s.type == ShapeType::Capsule ? s.radius : s.radius * std::sqrt(std::max(0.0, 1.0 - a[k] * a[k]));
-        half[k] = std::fabs(a[k]) * s.halfLength + rim;
-      }
-      break;
-    }
-    case ShapeType::ConvexHull: {
-      Eigen::AlignedBox3d box;
-      for (const Eigen::Vector3d& v : s.hull) box.extend(pose * v);
-      if (box.isEmpty()) box.extend(c);
-      const Eigen::Vector3d grow = Eigen::Vector3d::Constant(s.radius);
-      return Eigen::AlignedBox3d(box.min() - grow, box.max() + grow);
-    }
-  }
-  return Eigen::AlignedBox3d(c - half, c + half);
-}
-
 namespace {
 
 struct Frame {

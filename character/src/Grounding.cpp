@@ -30,29 +30,43 @@ std::string lower(std::string s) {
 
 }  // namespace
 
-double lowestPointY(const ShapeDesc& shape, const Eigen::Isometry3d& pose) {
-  const Eigen::Vector3d& c = pose.translation();
-  const Eigen::Matrix3d& r = pose.linear();
-  switch (shape.type) {
+Eigen::AlignedBox3d shapeBounds(const ShapeDesc& s, const Eigen::Isometry3d& pose) {
+  const Eigen::Matrix3d r = pose.linear();
+  const Eigen::Vector3d c = pose.translation();
+  Eigen::Vector3d half = Eigen::Vector3d::Zero();
+  switch (s.type) {
     case ShapeType::Sphere:
-      return c.y() - shape.radius;
+      half.setConstant(s.radius);
+      break;
     case ShapeType::Box:
-      // The corner with every local axis taken the way that goes down.
-      return c.y() - std::abs(r(1, 0)) * shape.halfExtents.x() - std::abs(r(1, 1)) * shape.halfExtents.y() -
-             std::abs(r(1, 2)) * shape.halfExtents.z();
-    case ShapeType::Cylinder: {
-      const double ay = r(1, 2);  // the axis (local z) in the world, its y
-      return c.y() - shape.halfLength * std::abs(ay) - shape.radius * std::sqrt(std::max(0.0, 1.0 - ay * ay));
+      half = r.cwiseAbs() * s.halfExtents;
+      break;
+    case ShapeType::Cylinder:
+    case ShapeType::Capsule: {
+      // Along each world axis k: the axis' reach |a_k| h, plus the rim's r sqrt(1 - a_k^2) for a cylinder or
+      // the end spheres' r for a capsule.
+      const Eigen::Vector3d a = r.col(2);
+      for (int k = 0; k < 3; ++k) {
+        const double rim =
+            s.type == ShapeType::Capsule ? s.radius : s.radius * std::sqrt(std::max(0.0, 1.0 - a[k] * a[k]));
+        half[k] = std::fabs(a[k]) * s.halfLength + rim;
+      }
+      break;
     }
-    case ShapeType::Capsule:
-      return c.y() - shape.halfLength * std::abs(r(1, 2)) - shape.radius;
     case ShapeType::ConvexHull: {
-      double lowest = std::numeric_limits<double>::infinity();
-      for (const Eigen::Vector3d& v : shape.hull) lowest = std::min(lowest, (pose * v).y());
-      return lowest - shape.radius;
+      Eigen::AlignedBox3d box;
+      for (const Eigen::Vector3d& v : s.hull) box.extend(pose * v);
+      if (box.isEmpty()) return box;  // no vertices: empty bounds
+      const Eigen::Vector3d grow = Eigen::Vector3d::Constant(s.radius);
+      return Eigen::AlignedBox3d(box.min() - grow, box.max() + grow);
     }
   }
-  return std::numeric_limits<double>::infinity();
+  return Eigen::AlignedBox3d(c - half, c + half);
+}
+
+double lowestPointY(const ShapeDesc& shape, const Eigen::Isometry3d& pose) {
+  const Eigen::AlignedBox3d bounds = shapeBounds(shape, pose);
+  return bounds.isEmpty() ? std::numeric_limits<double>::infinity() : bounds.min().y();
 }
 
 std::optional<double> lowestCollisionPoint(const Skeleton& skeleton) {

@@ -1,7 +1,7 @@
 // Loading a URDF with urdfdom into the plain data of Urdf.h, with every failure turned into a Status.
 #include "cape/character/Urdf.h"
 
-#include "cape/character/Anchors.h"
+#include "cape/character/Grounding.h"
 #include "cape/character/Skeleton.h"
 
 #include "UrdfGeometry.h"

@@ -3,6 +3,8 @@
 // exact bounds of every shape type; and the up axis turns a character into a Z-up world without changing it.
 #include "cape/character/Anchors.h"
 
+#include "CharacterTestWorld.h"
+
 #include <gtest/gtest.h>
 
 #include <btBulletDynamicsCommon.h>
@@ -10,16 +12,9 @@
 #include <random>
 
 using namespace cape::character;
+using capetest::World;
 
 namespace {
-
-struct World {
-  btDefaultCollisionConfiguration config;
-  btCollisionDispatcher dispatcher{&config};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
-};
 
 // A torso box (back 0.11 m behind the shoulders) with each arm hanging from it through shoulder pitch, roll
 // and yaw joints in a chain of shape-less links: the arm hangs from the torso, not from a shoulder link.

@@ -2,6 +2,8 @@
 // btDiscreteDynamicsWorld stepped as docs/SCENES.md says (stepSimulation(1/60, 8, 1/240)).
 #include "cape/character/Character.h"
 
+#include "CharacterTestWorld.h"
+
 #include <gtest/gtest.h>
 
 #include <btBulletDynamicsCommon.h>
@@ -10,18 +12,9 @@
 #include <memory>
 
 using namespace cape::character;
+using capetest::World;
 
 namespace {
-
-// A plain Bullet world, as a user would make one.
-struct World {
-  btDefaultCollisionConfiguration config;
-  btCollisionDispatcher dispatcher{&config};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
-  World() { world.setGravity(btVector3(0, -9.8f, 0)); }
-};
 
 UrdfModelPtr humanoid() {
   const UrdfLoadResult r = UrdfModel::humanoid();

@@ -4,6 +4,8 @@
 #include "cape/character/Character.h"
 #include "cape/character/Grounding.h"
 
+#include "CharacterTestWorld.h"
+
 #include <gtest/gtest.h>
 
 #include <btBulletDynamicsCommon.h>
@@ -16,18 +18,11 @@
 #include <string>
 
 using namespace cape::character;
+using capetest::World;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-struct World {
-  btDefaultCollisionConfiguration config;
-  btCollisionDispatcher dispatcher{&config};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
-};
 
 // A humanoid whose root link is its pelvis, 0.93 m above its soles: hips 5 cm below it, 0.8 m legs, feet
 // 6 cm thick centred under the ankles (so the walk's bent stance knee at t = 0 moves the sole under 1 mm),

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "cape/character/Character.h"
+#include "cape/character/Grounding.h"
 #include "cape/character/Status.h"
 
 #include <Eigen/Geometry>
@@ -12,9 +13,6 @@
 #include <string>
 
 namespace cape::character {
-
-/// The exact axis-aligned bounds of one collision shape placed at `pose` (m, in whatever frame pose is in).
-Eigen::AlignedBox3d shapeBounds(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
 
 struct ShoulderAnchors {
   Status status;  ///< an error (NotMovable, UnknownLink) when no shoulders could be found

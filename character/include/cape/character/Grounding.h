@@ -25,6 +25,10 @@ namespace cape::character {
 ///   hull      its lowest vertex - radius (its rounding); +infinity for a hull without vertices
 double lowestPointY(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
 
+/// The exact axis-aligned bounds of one collision shape placed at `pose` (m, in whatever frame pose is in):
+/// lowestPointY is its min().y().
+Eigen::AlignedBox3d shapeBounds(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
+
 /// The lowest world y over every collision shape of the skeleton at its current pose; none when it has no
 /// shapes (or only empty hulls).
 std::optional<double> lowestCollisionPoint(const Skeleton& skeleton);
