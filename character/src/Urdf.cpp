@@ -2,6 +2,7 @@
 #include "cape/character/Urdf.h"
 
 #include "cape/character/Grounding.h"
+#include "cape/character/JointMapping.h"
 #include "cape/character/Skeleton.h"
 
 #include "UrdfGeometry.h"
@@ -263,38 +264,61 @@ struct UrdfModelBuilder {
 
   // A model that stands along its y axis turned onto z (REP 103), by turning what hangs below the root link
   // (its shapes and its child joints' origins) +90 degrees about x: y -> z, z -> -y, x stays forward.
-  static void standUp(UrdfModel& model, UrdfLoadOptions::Up up) {
-    if (up == UrdfLoadOptions::Up::Auto) {
-      const auto zeroPose = std::make_shared<const UrdfModel>(model);
-      const Skeleton probe(zeroPose);
-      Eigen::AlignedBox3d box;
-      const Eigen::Matrix3d toUrdf = Skeleton::urdfToWorld().transpose();
-      for (const WorldShape& w : probe.worldShapes()) {
-        Eigen::Isometry3d p = w.pose;
-        p.linear() = toUrdf * p.linear();
-        p.translation() = toUrdf * p.translation();
-        box.extend(shapeBounds(*w.shape, p));
-      }
-      if (box.isEmpty() || !(box.sizes().y() > 2.0 * box.sizes().z())) return;
-      // Only said: an upper body in a T-pose is long along y too, and turning it would be wrong.
-      char line[240];
-      std::snprintf(
-          line, sizeof line,
-          "the model is %.2f m long along y and %.2f m along z in its zero pose: if it stands along "
-          "y (a Y-up model), load it with UrdfLoadOptions::modelUp = Y (cape_walk --model-up y)",
-          box.sizes().y(), box.sizes().z());
-      model.warnings_.push_back(line);
-      return;
-    }
-    if (up == UrdfLoadOptions::Up::Z) {
-      return;
-    }
+  static void turnOntoZ(UrdfModel& model) {
     const Eigen::Isometry3d turn(Eigen::AngleAxisd(0.5 * 3.14159265358979323846, Eigen::Vector3d::UnitX()));
     for (ShapeDesc& shape : model.links_[0].shapes) shape.origin = turn * shape.origin;
     for (int j : model.links_[0].childJoints) {
       JointDesc& joint = model.joints_[static_cast<std::size_t>(j)];
       joint.origin = turn * joint.origin;
     }
+  }
+
+  // How many of the legs' joints (hips, knees, ankles) the joint mapping finds by structure alone.
+  static int legJointsByStructure(const UrdfModel& model) {
+    const JointMapping m = JointMapping::byStructure(std::make_shared<const UrdfModel>(model));
+    int found = 0;
+    for (GaitRole role : {GaitRole::LeftHip, GaitRole::RightHip, GaitRole::LeftKnee, GaitRole::RightKnee,
+                          GaitRole::LeftAnkle, GaitRole::RightAnkle})
+      found += m[role].joint >= 0 ? 1 : 0;
+    return found;
+  }
+
+  static void standUp(UrdfModel& model, UrdfLoadOptions::Up up) {
+    if (up == UrdfLoadOptions::Up::Z) return;
+    if (up == UrdfLoadOptions::Up::Y) return turnOntoZ(model);
+    // Auto: a model more than twice as long along y as along z in its zero pose may stand along y. So may an
+    // upper body in a T-pose; what tells them apart is the legs: turned, a Y-up humanoid's legs go down and
+    // the mapping finds their joints by structure. Turned only then, and said.
+    const Skeleton probe(std::make_shared<const UrdfModel>(model));
+    Eigen::AlignedBox3d box;
+    const Eigen::Matrix3d toUrdf = Skeleton::urdfToWorld().transpose();
+    for (const WorldShape& w : probe.worldShapes()) {
+      Eigen::Isometry3d p = w.pose;
+      p.linear() = toUrdf * p.linear();
+      p.translation() = toUrdf * p.translation();
+      box.extend(shapeBounds(*w.shape, p));
+    }
+    if (box.isEmpty() || !(box.sizes().y() > 2.0 * box.sizes().z())) return;
+    UrdfModel turned = model;
+    turnOntoZ(turned);
+    const int asIs = legJointsByStructure(model), standing = legJointsByStructure(turned);
+    char line[300];
+    if (standing > asIs) {
+      std::snprintf(
+          line, sizeof line,
+          "the model is %.2f m long along y and %.2f m along z in its zero pose, and its legs go down "
+          "along y: read as a Y-up model and turned onto z (UrdfLoadOptions::modelUp, cape_walk "
+          "--model-up z keeps it as written)",
+          box.sizes().y(), box.sizes().z());
+      model = std::move(turned);
+    } else {
+      std::snprintf(
+          line, sizeof line,
+          "the model is %.2f m long along y and %.2f m along z in its zero pose: if it stands along "
+          "y (a Y-up model), load it with UrdfLoadOptions::modelUp = Y (cape_walk --model-up y)",
+          box.sizes().y(), box.sizes().z());
+    }
+    model.warnings_.push_back(line);
   }
 
   static Status readJoint(const urdf::Joint& src, JointDesc& joint) {

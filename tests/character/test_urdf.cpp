@@ -430,6 +430,46 @@ TEST(Urdf, AModelStandingAlongYIsTurnedOntoZ) {
   EXPECT_TRUE(UrdfModel::humanoid().warnings.empty());
 }
 
+TEST(Urdf, AYUpHumanoidWithLegsIsTurnedByItself) {
+  // Y-up, x forward, z to the right (as DeepMimic's humanoid): legs hang along -y from hip and knee joints
+  // about z, the torso rises along +y.
+  std::string xml = R"(<robot name="yup"><link name="pelvis"><collision><geometry><box size="0.2 0.15 0.3"/>
+      </geometry></collision></link>
+      <link name="torso"><collision><origin xyz="0 0.3 0"/><geometry><box size="0.2 0.5 0.35"/></geometry></collision></link>
+      <joint name="waist" type="fixed"><parent link="pelvis"/><child link="torso"/><origin xyz="0 0.1 0"/></joint>)";
+  for (const char* side : {"left", "right"}) {
+    const std::string z = std::string(side) == "left" ? "-0.1" : "0.1";
+    const std::string s(side);
+    xml += "<link name='" + s +
+           "_thigh'><collision><origin xyz='0 -0.2 0'/><geometry><box size='0.1 0.4 0.1'/>"
+           "</geometry></collision></link><link name='" +
+           s +
+           "_shin'><collision><origin xyz='0 -0.2 0'/>"
+           "<geometry><box size='0.1 0.4 0.1'/></geometry></collision></link>"
+           "<joint name='" +
+           s + "_hip' type='revolute'><parent link='pelvis'/><child link='" + s +
+           "_thigh'/>"
+           "<origin xyz='0 -0.05 " +
+           z +
+           "'/><axis xyz='0 0 1'/><limit lower='-2' upper='2' effort='1' velocity='1'/></joint>"
+           "<joint name='" +
+           s + "_knee' type='revolute'><parent link='" + s + "_thigh'/><child link='" + s +
+           "_shin'/>"
+           "<origin xyz='0 -0.42 0'/><axis xyz='0 0 1'/><limit lower='-2' upper='2' effort='1' "
+           "velocity='1'/></joint>";
+  }
+  xml += "</robot>";
+  const UrdfLoadResult r = UrdfModel::fromString(xml);
+  ASSERT_TRUE(r.ok()) << r.status.message();
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings.back().find("turned onto z"), std::string::npos) << r.warnings.back();
+  // The knee now hangs along -z below the hip, and its axis is side to side (y).
+  const JointDesc& hip = jointNamed(*r.model, "left_hip");
+  EXPECT_TRUE(hip.origin.translation().isApprox(Eigen::Vector3d(0, 0.1, -0.05), 1e-12))
+      << hip.origin.translation();
+  EXPECT_NEAR(std::fabs((hip.origin.linear() * hip.axis).y()), 1.0, 1e-12);
+}
+
 TEST(Urdf, XmlCheckAcceptsOrdinaryDocuments) {
   std::string msg;
   EXPECT_TRUE(

@@ -87,9 +87,9 @@ struct UrdfLoadOptions {
   bool loadMeshes = true;
   /// The axis the model stands along in its own file. REP 103 says z; models from Y-up tools (PyBullet's
   /// DeepMimic humanoid) stand along y, with x forward, and are turned here onto z (a +90 degree turn about
-  /// x of everything below the root link). Auto: z, with a warning suggesting Y when the model in its zero
-  /// pose is more than twice as long along y as along z (a Y-up humanoid; but also an upper body in a
-  /// T-pose, so nothing is turned unless asked).
+  /// x of everything below the root link). Auto: z, unless the model in its zero pose is more than twice as
+  /// long along y as along z and, turned, has legs whose joints the mapping finds by structure (an upper body
+  /// in a T-pose is long along y too, but has no legs either way); either case is said in a warning.
   enum class Up : int { Auto, Z, Y };
   Up modelUp = Up::Auto;
 };
