@@ -64,18 +64,26 @@ Eigen::AlignedBox3d shapeBounds(const ShapeDesc& s, const Eigen::Isometry3d& pos
   return Eigen::AlignedBox3d(c - half, c + half);
 }
 
+Eigen::AlignedBox3d skeletonBounds(const Skeleton& skeleton, const Eigen::Matrix3d& turn) {
+  Eigen::AlignedBox3d box;
+  for (const WorldShape& w : skeleton.worldShapes()) {
+    Eigen::Isometry3d p = w.pose;
+    p.linear() = turn * p.linear();
+    p.translation() = turn * p.translation();
+    box.extend(shapeBounds(*w.shape, p));
+  }
+  return box;
+}
+
 double lowestPointY(const ShapeDesc& shape, const Eigen::Isometry3d& pose) {
   const Eigen::AlignedBox3d bounds = shapeBounds(shape, pose);
   return bounds.isEmpty() ? std::numeric_limits<double>::infinity() : bounds.min().y();
 }
 
 std::optional<double> lowestCollisionPoint(const Skeleton& skeleton) {
-  std::optional<double> lowest;
-  for (const WorldShape& w : skeleton.worldShapes()) {
-    const double y = lowestPointY(*w.shape, w.pose);
-    if (std::isfinite(y) && (!lowest || y < *lowest)) lowest = y;
-  }
-  return lowest;
+  const Eigen::AlignedBox3d box = skeletonBounds(skeleton, Eigen::Matrix3d::Identity());
+  if (box.isEmpty()) return std::nullopt;
+  return box.min().y();
 }
 
 GroundPlacement placeOnGround(const Skeleton& standing, const std::optional<double>& rootHeight) {

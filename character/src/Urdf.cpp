@@ -290,14 +290,7 @@ struct UrdfModelBuilder {
     // upper body in a T-pose; what tells them apart is the legs: turned, a Y-up humanoid's legs go down and
     // the mapping finds their joints by structure. Turned only then, and said.
     const Skeleton probe(std::make_shared<const UrdfModel>(model));
-    Eigen::AlignedBox3d box;
-    const Eigen::Matrix3d toUrdf = Skeleton::urdfToWorld().transpose();
-    for (const WorldShape& w : probe.worldShapes()) {
-      Eigen::Isometry3d p = w.pose;
-      p.linear() = toUrdf * p.linear();
-      p.translation() = toUrdf * p.translation();
-      box.extend(shapeBounds(*w.shape, p));
-    }
+    const Eigen::AlignedBox3d box = skeletonBounds(probe, Skeleton::urdfToWorld().transpose());
     if (box.isEmpty() || !(box.sizes().y() > 2.0 * box.sizes().z())) return;
     UrdfModel turned = model;
     turnOntoZ(turned);

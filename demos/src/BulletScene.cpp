@@ -199,14 +199,8 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
     for (const std::string& w : c->urdf->warnings())
       if (std::find(warnings_.begin(), warnings_.end(), w) == warnings_.end()) warnings_.push_back(w);
     // A humanoid far taller or shorter than people and robots are may not be in metres.
-    Eigen::AlignedBox3d box;
-    const Eigen::Matrix3d toScene = character::Skeleton::sceneToWorld(options_.up).transpose();
-    for (const character::WorldShape& w : c->urdf->skeleton().worldShapes()) {
-      Eigen::Isometry3d p = w.pose;
-      p.linear() = toScene * p.linear();
-      p.translation() = toScene * p.translation();
-      box.extend(character::shapeBounds(*w.shape, p));
-    }
+    const Eigen::AlignedBox3d box = character::skeletonBounds(
+        c->urdf->skeleton(), character::Skeleton::sceneToWorld(options_.up).transpose());
     if (!box.isEmpty() && (box.max().y() > 3.0 || box.max().y() < 0.3)) {
       char line[160];
       std::snprintf(line, sizeof line,

@@ -29,6 +29,11 @@ double lowestPointY(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
 /// lowestPointY is its min().y().
 Eigen::AlignedBox3d shapeBounds(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
 
+/// The bounds of every collision shape of the skeleton at its current pose, in the frame `turn` takes the
+/// world into (the identity: the world; Skeleton::urdfToWorld().transpose(): the URDF's axes). Empty when
+/// it has no shapes.
+Eigen::AlignedBox3d skeletonBounds(const Skeleton& skeleton, const Eigen::Matrix3d& turn);
+
 /// The lowest world y over every collision shape of the skeleton at its current pose; none when it has no
 /// shapes (or only empty hulls).
 std::optional<double> lowestCollisionPoint(const Skeleton& skeleton);
