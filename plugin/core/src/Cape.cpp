@@ -5,6 +5,8 @@
 #include "CapeScratch.h"
 #include "SpringSolver.h"
 
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -59,6 +61,7 @@ detail::CapeScratch::CapeScratch(const Fabric& fabric) : body(fabric.particleCou
   lambda = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.springCount()));
   invDenominator = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.springCount()));
   selfWeight = Eigen::VectorXf::Zero(n);
+  lost.reserve(static_cast<std::size_t>(n));
 }
 
 Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement)
@@ -82,6 +85,9 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   state_.velocities = Points::Zero(n, 3);
   state_.inverseMasses = fabric_->masses().cwiseInverse();
   state_.pins.reserve(static_cast<std::size_t>(n));
+  reference_ = placement;
+  reference_.rotation.normalize();
+  pinnedComponent_.assign(fabric_->componentCount(), 0);
   work_ = std::make_unique<detail::CapeScratch>(*fabric_);
   work_->startPositions = state_.positions;
 }
@@ -140,6 +146,7 @@ std::size_t Cape::pin(std::uint32_t particle, const Vec3& target) {
   }
   state_.inverseMasses[particle] = 0.0f;
   state_.pins.push_back({particle, target, target});
+  markPinnedComponents();
   return state_.pins.size() - 1;
 }
 
@@ -150,6 +157,7 @@ void Cape::unpin(std::uint32_t particle) {
   if (it == state_.pins.end()) return;
   state_.pins.erase(it);
   state_.inverseMasses[particle] = 1.0f / fabric_->masses()[particle];
+  markPinnedComponents();
 }
 
 void Cape::movePin(std::size_t k, const Vec3& target) {
@@ -159,8 +167,34 @@ void Cape::movePin(std::size_t k, const Vec3& target) {
   if (target.allFinite()) p.target = target;  // a non-finite target is ignored: the pin holds still
 }
 
+void Cape::markPinnedComponents() {
+  std::fill(pinnedComponent_.begin(), pinnedComponent_.end(), std::uint8_t{0});
+  for (const Pin& p : state_.pins) pinnedComponent_[fabric_->components()[p.particle]] = 1;
+}
+
+void Cape::setOrigin(const Eigen::Vector3d& origin) {
+  if (!ok() || !origin.allFinite()) return;
+  // Frame coordinates change by old - new, computed in double and rounded once.
+  const Vec3 d = (origin_ - origin).cast<float>();
+  origin_ = origin;
+  if (d.isZero()) return;
+  state_.positions.rowwise() += d.transpose();
+  work_->startPositions.rowwise() += d.transpose();
+  for (Pin& p : state_.pins) {
+    p.previousTarget += d;
+    p.target += d;
+  }
+  reference_.position += d;
+}
+
+void Cape::relocate(const Eigen::Vector3d& origin) {
+  if (ok() && origin.allFinite()) origin_ = origin;
+}
+
 void Cape::teleport(const Pose& delta) {
   if (!ok() || !delta.isFinite()) return;
+  reference_.position = delta.apply(reference_.position);
+  reference_.rotation = (delta.rotation * reference_.rotation).normalized();
   const Eigen::Matrix3f r = delta.rotation.toRotationMatrix();
   for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
     state_.positions.row(i) = (r * state_.positions.row(i).transpose() + delta.position).transpose();
@@ -174,6 +208,8 @@ void Cape::teleport(const Pose& delta) {
 
 void Cape::carry(const Eigen::Matrix3f& m, const Vec3& centre, const Vec3& shift) {
   if (!ok() || !m.allFinite() || !centre.allFinite() || !shift.allFinite()) return;
+  reference_.position = m * (reference_.position - centre) + centre + shift;
+  reference_.rotation = (Quat(m) * reference_.rotation).normalized();
   for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
     const Vec3 x = state_.positions.row(i).transpose();
     state_.positions.row(i) = (m * (x - centre) + centre + shift).transpose();
@@ -184,6 +220,7 @@ void Cape::carry(const Eigen::Matrix3f& m, const Vec3& centre, const Vec3& shift
 
 void Cape::step(float dt, ColliderSpan colliders) {
   if (!ok() || !std::isfinite(dt) || !(dt > 0.0f)) return;
+  dt = std::min(dt, kMaxStep);
   const StepPlan plan = planSubsteps(dt);
   beginStep(plan, dt, colliders);
   int searchEvery = 0;  // substeps between self-contact searches inside the loop; 0: none there
@@ -207,13 +244,18 @@ Cape::StepPlan Cape::planSubsteps(float dt) const {
   // settings.substeps are per settings.timeStep: a step of another length keeps the substep length, so a
   // world stepping at 1/240 s takes one substep where a 1/60 s frame takes three (the 1e-3 keeps dt =
   // timeStep at exactly `substeps` despite rounding).
+  // Counts are bounded before they become ints (dt <= kMaxStep, timeStep >= 1e-5 s: at most 1e8 substeps
+  // before refinement; the cap keeps a pathological explicit bound from overflowing).
+  constexpr double kMaxSubsteps = 1e6;
   const float targetSubstep = settings_.timeStep / static_cast<float>(settings_.substeps);
-  int substeps = std::max(1, static_cast<int>(std::ceil(dt / targetSubstep - 1e-3f)));
+  int substeps = static_cast<int>(
+      std::clamp(std::ceil(static_cast<double>(dt / targetSubstep - 1e-3f)), 1.0, kMaxSubsteps));
   if (settings_.integrator == Integrator::Xpbd) substeps *= refinement_;
   if (settings_.integrator == Integrator::ExplicitSpring) {
     // A longer step than the settings were checked for: split it further rather than blow up.
     const float hMax = explicitStableStep(*fabric_, settings_);
-    substeps = std::max(substeps, static_cast<int>(std::ceil(dt / (0.9f * hMax))));
+    const double needed = std::ceil(static_cast<double>(dt) / (0.9 * static_cast<double>(hMax)));
+    substeps = std::max(substeps, static_cast<int>(std::clamp(needed, 1.0, kMaxSubsteps)));
   }
   return {substeps, dt / static_cast<float>(substeps)};
 }
@@ -226,16 +268,112 @@ void Cape::beginStep(const StepPlan& plan, float dt, ColliderSpan colliders) {
   // far slower than a frame.
   if (settings_.wind.model != WindSettings::Model::None)
     windVelocities(settings_.wind, state_.positions, state_.time + 0.5 * static_cast<double>(dt),
-                   work_->airVelocity);
+                   work_->airVelocity, origin_);
   // Triangle meshes: each particle's candidate triangles for the whole step, found once. The slack, a
   // quarter of the spacing, is the self-collision search's for the same reason.
   work_->body.beginStep(state_, colliders, settings_, dt, 0.25f * fabric_->meanSpacing());
 }
 
 void Cape::endStep(float dt) {
+  guardParticles(dt);
   for (Pin& p : state_.pins) p.previousTarget = p.target;
   state_.time += static_cast<double>(dt);
   adaptRefinement();
+}
+
+void Cape::guardParticles(float dt) {
+  // One pass over the particles (no allocation: `lost` has its capacity), whose result is almost always
+  // "none": the comparisons are written so that NaN fails them.
+  const Eigen::Index n = state_.positions.rows();
+  Vec3 centre = Vec3::Zero();
+  float bound2 = std::numeric_limits<float>::infinity();
+  if (!state_.pins.empty()) {
+    for (const Pin& p : state_.pins) centre += p.target;
+    centre /= static_cast<float>(state_.pins.size());
+    float reach = 0.0f;
+    for (const Pin& p : state_.pins) reach = std::max(reach, (p.target - centre).norm());
+    reach += settings_.guardReach * fabric_->restDiameter();
+    bound2 = reach * reach;
+  }
+  const float *px = state_.positions.col(0).data(), *py = state_.positions.col(1).data(),
+              *pz = state_.positions.col(2).data();
+  const float *vx = state_.velocities.col(0).data(), *vy = state_.velocities.col(1).data(),
+              *vz = state_.velocities.col(2).data();
+  const std::uint32_t* component = fabric_->components().data();
+  const std::uint8_t* pinned = pinnedComponent_.data();
+  std::vector<std::uint32_t>& lost = work_->lost;
+  lost.clear();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const float dx = px[i] - centre.x(), dy = py[i] - centre.y(), dz = pz[i] - centre.z();
+    // A piece no pin holds may go anywhere: only finiteness is asked of it (0 * x is NaN for x inf or NaN).
+    const float d2 = pinned[component[i]] != 0 ? dx * dx + dy * dy + dz * dz : 0.0f * (px[i] + py[i] + pz[i]);
+    const float v2 = vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i];
+    if (!(d2 <= bound2) || !(v2 <= std::numeric_limits<float>::max()))
+      lost.push_back(static_cast<std::uint32_t>(i));
+  }
+  guard_.lastStep = static_cast<std::uint32_t>(lost.size());
+  if (lost.empty()) return;
+  guard_.total += lost.size();
+  ++guard_.steps;
+  fitReferenceToPins();
+  Vec3 pinVelocity = Vec3::Zero();
+  for (const Pin& p : state_.pins) pinVelocity += (p.target - p.previousTarget) / dt;
+  if (!state_.pins.empty()) pinVelocity /= static_cast<float>(state_.pins.size());
+  if (!pinVelocity.allFinite()) pinVelocity.setZero();
+  const Points& rest = fabric_->restPositions();
+  for (const std::uint32_t i : lost) {
+    Vec3 x = reference_.apply(rest.row(i).transpose());
+    if (state_.inverseMasses[i] == 0.0f)
+      for (const Pin& p : state_.pins)
+        if (p.particle == i) x = p.target;
+    state_.positions.row(i) = x.transpose();
+    state_.velocities.row(i) = pinVelocity.transpose();
+  }
+}
+
+void Cape::fitReferenceToPins() {
+  // The rotation R and shift t minimising sum |R r_k + t - x_k|^2 over the pins (rest point r_k, target
+  // x_k): Kabsch's, from the SVD of M = sum (r_k - r)(x_k - x)^T. With fewer than three pins, or pins on a
+  // line, some rotations are not fixed by them: a small multiple of the current rotation added to M takes
+  // those from the pose the reference had, so the fit turns it as little as the pins allow. No pins: the
+  // reference follows the mean displacement of the particles still finite.
+  const Points& rest = fabric_->restPositions();
+  if (state_.pins.empty()) {
+    Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+    std::size_t count = 0;
+    for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
+      const Vec3 x = state_.positions.row(i).transpose();
+      if (!x.allFinite() || x.cwiseAbs().maxCoeff() > 1e30f) continue;
+      shift += (x - reference_.apply(rest.row(i).transpose())).cast<double>();
+      ++count;
+    }
+    if (count > 0) reference_.position += (shift / static_cast<double>(count)).cast<float>();
+    return;
+  }
+  Eigen::Vector3d r = Eigen::Vector3d::Zero(), x = Eigen::Vector3d::Zero();
+  for (const Pin& p : state_.pins) {
+    r += rest.row(p.particle).transpose().cast<double>();
+    x += p.target.cast<double>();
+  }
+  const double count = static_cast<double>(state_.pins.size());
+  r /= count;
+  x /= count;
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  double spread = 0.0;
+  for (const Pin& p : state_.pins) {
+    const Eigen::Vector3d a = rest.row(p.particle).transpose().cast<double>() - r;
+    m += a * (p.target.cast<double>() - x).transpose();
+    spread += a.squaredNorm();
+  }
+  const Eigen::Matrix3d previous = reference_.rotation.toRotationMatrix().cast<double>();
+  m += 1e-3 * std::max(spread, 1e-12) * previous.transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  const Eigen::Matrix3d rotation = svd.matrixV() * d * svd.matrixU().transpose();
+  if (!rotation.allFinite()) return;
+  reference_.rotation = Quat(rotation.cast<float>()).normalized();
+  reference_.position = (x - rotation * r).cast<float>();
 }
 
 void Cape::adaptRefinement() {

@@ -61,8 +61,10 @@ Status CapeSettings::validate() const {
   if (iterations < 1 || iterations > 1000)
     return Status::error("CapeSettings: iterations must be in 1..1000");
   if (!gravity.allFinite()) return Status::error("CapeSettings: gravity must be finite");
-  if (!(std::isfinite(timeStep) && timeStep > 0.0f))
-    return Status::error("CapeSettings: timeStep must be > 0 s");
+  if (!(timeStep >= 1e-5f && timeStep <= 1.0f))
+    return Status::error("CapeSettings: timeStep must be in 1e-5..1 s");
+  if (!(std::isfinite(guardReach) && guardReach > 0.0f))
+    return Status::error("CapeSettings: guardReach must be finite and > 0 (rest diameters)");
   if (wind.model != WindSettings::Model::None) {
     if (!wind.direction.allFinite() || !(wind.direction.norm() > 0.0f))
       return Status::error("CapeSettings: wind direction must be a finite nonzero vector");

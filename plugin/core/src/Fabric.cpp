@@ -298,7 +298,31 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
         structural.size() > 0 ? static_cast<float>(sum / static_cast<double>(structural.size())) : 0.01f;
   }
   buildTriangleTables();
+  buildComponents();
   return buildTethers(anchors, tethersPerParticle, tetherScale);
+}
+
+void Fabric::buildComponents() {
+  // Union-find over every spring (path halving, union by index: deterministic), then labels 0, 1, ... in the
+  // order of each component's first particle.
+  const std::size_t n = particleCount();
+  std::vector<std::uint32_t> parent(n);
+  for (std::size_t i = 0; i < n; ++i) parent[i] = static_cast<std::uint32_t>(i);
+  const auto root = [&](std::uint32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (const SpringSet& set : springs_)
+    for (std::size_t s = 0; s < set.size(); ++s) {
+      const std::uint32_t a = root(set.first[s]), b = root(set.second[s]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  components_.assign(n, 0);
+  componentCount_ = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t r = root(static_cast<std::uint32_t>(i));
+    components_[i] = r == i ? componentCount_++ : components_[r];
+  }
 }
 
 Status Fabric::buildTethers(const std::vector<std::uint32_t>& anchors, int tethersPerParticle,

@@ -2,12 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
 namespace cape::detail {
+
+// The largest squared length a spring is solved at: beyond it the square has overflowed (or nearly).
+constexpr float kMaxLength2 = std::numeric_limits<float>::max();
 
 void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end,
                         float alphaTilde) {
@@ -23,8 +27,9 @@ void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::ui
     const float wi = w[i], wj = w[j];
     const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
     const float len2 = dx * dx + dy * dy + dz * dz;
-    // invDenominator is 0 when both ends are pinned; a zero length has no direction.
-    if (!(len2 > 1e-18f)) continue;
+    // invDenominator is 0 when both ends are pinned; a zero length has no direction, and a length whose
+    // square overflows (a runaway particle, restored by the cape's guard after the step) no finite one.
+    if (!(len2 > 1e-18f && len2 <= kMaxLength2)) continue;
     const float len = std::sqrt(len2);
     const float dl = (a.restLength[s] - len - alphaTilde * lambda[s]) * a.invDenominator[s];
     lambda[s] += dl;
@@ -157,6 +162,7 @@ void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t 
   using In = Lanes<L>;
   const __m128 alpha = _mm_set1_ps(alphaTilde);
   const __m128 minLen2 = _mm_set1_ps(1e-18f);
+  const __m128 maxLen2 = _mm_set1_ps(kMaxLength2);
   for (std::uint32_t s = begin; s < end; s += 4) {
     const std::uint32_t* p = a.first + s;
     const std::uint32_t* q = a.second + s;
@@ -167,7 +173,8 @@ void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t 
     In::load(a.inverseMass, p, q, wi, wj);
     const __m128 dx = _mm_sub_ps(xj, xi), dy = _mm_sub_ps(yj, yi), dz = _mm_sub_ps(zj, zi);
     const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-    const __m128 active = _mm_cmpgt_ps(len2, minLen2);  // false for NaN too
+    const __m128 active =  // false for NaN and for an overflowed square too
+        _mm_and_ps(_mm_cmpgt_ps(len2, minLen2), _mm_cmple_ps(len2, maxLen2));
     const __m128 len = _mm_sqrt_ps(len2);
     const __m128 lambda = _mm_loadu_ps(a.lambda + s);
     const __m128 dl =

@@ -69,9 +69,12 @@ GustField makeField(const WindSettings& w) {
 constexpr float kCrossWind = 0.3f;
 
 /// The gust signal of one component at a time: phase argument wrapped to keep float precision over long runs.
-float wrappedPhase(const Wave& w, double time) {
-  return static_cast<float>(
-      std::fmod(static_cast<double>(w.omega) * time + static_cast<double>(w.phase), kTwoPi));
+/// The wave's phase at the frame's origin `k . origin` is taken in double, before the wrap: far from the
+/// world's origin the float points keep their precision.
+float wrappedPhase(const Wave& w, double time, const Eigen::Vector3d& origin) {
+  return static_cast<float>(std::fmod(
+      static_cast<double>(w.omega) * time + static_cast<double>(w.phase) - w.k.cast<double>().dot(origin),
+      kTwoPi));
 }
 
 }  // namespace
@@ -83,7 +86,8 @@ Vec3 windVelocity(const WindSettings& wind, const Vec3& point, double time) {
   return out.row(0).transpose();
 }
 
-void windVelocities(const WindSettings& wind, const Points& points, double time, Points& out) {
+void windVelocities(const WindSettings& wind, const Points& points, double time, Points& out,
+                    const Eigen::Vector3d& origin) {
   switch (wind.model) {
     case WindSettings::Model::None:
       out.setZero();
@@ -107,7 +111,7 @@ void windVelocities(const WindSettings& wind, const Points& points, double time,
     auto g = out.col(c).array();
     g.setZero();
     for (const Wave& w : f.waves[static_cast<std::size_t>(c)]) {
-      g += w.amplitude * (wrappedPhase(w, time) - (X * w.k.x() + Y * w.k.y() + Z * w.k.z())).sin();
+      g += w.amplitude * (wrappedPhase(w, time, origin) - (X * w.k.x() + Y * w.k.y() + Z * w.k.z())).sin();
     }
   }
   // ...then v = U (along (1 + a g0) + c a (across1 g1 + across2 g2)), a 3 x 3 map of each row.

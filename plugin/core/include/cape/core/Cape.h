@@ -73,10 +73,43 @@ class Cape {
   /// feel (CapeActionSettings::linearInertia). Ignored unless every input is finite.
   void carry(const Eigen::Matrix3f& rotation, const Vec3& centre, const Vec3& shift);
 
+  /// The cape's frame (local space, as NvCloth's): every position the cape takes and gives (particles,
+  /// pins, colliders, the centres of carry() and teleport()) is relative to this world point, m. Zero unless
+  /// set, and then frame and world are one. A cape far from the world's origin keeps its float coordinates
+  /// small, and so their precision that of a cape at the origin, by moving its frame along (the Bullet
+  /// adapter does: CapeActionSettings::frameGrid).
+  const Eigen::Vector3d& origin() const { return origin_; }
+  /// Moves the frame to `origin`; the cape stays where it is in the world (its frame coordinates change by
+  /// the difference, rounded to float once). Ignored unless finite.
+  void setOrigin(const Eigen::Vector3d& origin);
+  /// Moves the frame to `origin` and the cape with it: frame coordinates stay, world positions move by the
+  /// difference (a teleport by a pure translation, exact however far). Ignored unless finite.
+  void relocate(const Eigen::Vector3d& origin);
+
+  /// The longest step simulated, s: a longer dt (a stalled game) is simulated as this long.
+  static constexpr float kMaxStep = 1.0f;
   /// Advances the cape by dt seconds against the colliders, which are swept from their previous to their
   /// current pose, in substeps of about settings().timeStep / settings().substeps (see
-  /// CapeSettings::substeps). Non-finite or non-positive dt is ignored.
+  /// CapeSettings::substeps). Non-finite or non-positive dt is ignored; dt > kMaxStep is kMaxStep. After the
+  /// step, the numerical guard (guard()) restores every particle it finds lost.
   void step(float dt, ColliderSpan colliders);
+
+  /// What the numerical guard did. After every step it checks every particle: one whose position or
+  /// velocity is not finite (or whose speed squared overflows a float), or, in a piece of the fabric a pin
+  /// holds (Fabric::components), that is farther from the pins' centroid than the farthest pin target plus
+  /// CapeSettings::guardReach times the fabric's rest diameter, is lost. Lost particles are restored to the
+  /// reference pose (referencePose(), carried by the pins: the rest shape fitted to the pin targets) with the
+  /// pins' mean velocity; a lost pinned particle to its pin's target. So no NaN or runaway particle outlives
+  /// the step it appeared in.
+  struct GuardReport {
+    std::uint32_t lastStep = 0;  ///< particles restored by the last step
+    std::uint64_t total = 0;     ///< particles restored since the cape was made
+    std::uint64_t steps = 0;     ///< steps that restored at least one
+  };
+  const GuardReport& guard() const { return guard_; }
+  /// Where the rest shape stands (frame coordinates; world = pose * rest): the placement, moved by
+  /// teleport() and carry(), and refitted to the pin targets whenever the guard restores a particle.
+  const Pose& referencePose() const { return reference_; }
 
   /// A particle that touched a collider in this substep's collision pass (index into the step's colliders).
   struct Contact {
@@ -117,6 +150,9 @@ class Cape {
   StepPlan planSubsteps(float dt) const;
   void beginStep(const StepPlan& plan, float dt, ColliderSpan colliders);
   void endStep(float dt);
+  void guardParticles(float dt);
+  void fitReferenceToPins();
+  void markPinnedComponents();
   // The stages of one substep [s0, s1] (fractions of the step) of length h.
   void substepXpbd(float h, float s0, float s1, ColliderSpan colliders);
   void substepExplicit(float h, float s0, float s1, ColliderSpan colliders);
@@ -137,8 +173,12 @@ class Cape {
   FabricPtr fabric_;
   CapeSettings settings_;
   std::array<float, kSpringFamilyCount> familyCompliance_{};  ///< 1 / stiffness per family, m/N (inf: off).
-  int refinement_ = 1;          ///< Substep multiplier of the next step (1, 2, 4, ...).
-  float lastMaxStrain_ = 0.0f;  ///< Max structural strain after the last step.
+  int refinement_ = 1;                                ///< Substep multiplier of the next step (1, 2, 4, ...).
+  float lastMaxStrain_ = 0.0f;                        ///< Max structural strain after the last step.
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  ///< World position of the cape's frame, m.
+  Pose reference_;                                    ///< The rest shape's pose in the frame.
+  std::vector<std::uint8_t> pinnedComponent_;         ///< 1 for each fabric component holding a pin.
+  GuardReport guard_;
   CapeState state_;
   Status status_ = Status::success();
   std::unique_ptr<detail::CapeScratch> work_;  ///< Sized once; null while the cape is not ok().

@@ -65,12 +65,16 @@ struct CapeSettings {
   /// full refinement for nothing: raise the limit or set 0.
   float strainLimit = 0.05f;
   int maxRefinement = 4;  ///< >= 1
+  /// The numerical guard's reach (Cape::guard()), in rest diameters of the fabric beyond the farthest pin:
+  /// a particle farther from the pins is lost and restored. > 0; the default is far beyond any stretch the
+  /// springs allow, so only a runaway trips it.
+  float guardReach = 2.0f;
   /// Constraint iterations per substep, >= 1.
   int iterations = 1;
   /// Gravity, m/s^2.
   Vec3 gravity = Vec3(0.0f, -9.8f, 0.0f);
-  /// The frame time the settings are tuned for, s: `substeps` are per this long, and validate() checks the
-  /// explicit mode's stability bound at timeStep / substeps.
+  /// The frame time the settings are tuned for, s, 1e-5..1: `substeps` are per this long, and validate()
+  /// checks the explicit mode's stability bound at timeStep / substeps.
   float timeStep = 1.0f / 60.0f;
 
   WindSettings wind;

@@ -142,6 +142,10 @@ class Fabric {
   int gridRows() const { return gridRows_; }
   /// The largest distance between two particles at rest (bounds how far any particle can be from a pin).
   float restDiameter() const { return restDiameter_; }
+  /// The connected component of each particle through the springs of every family, labelled 0, 1, ... in the
+  /// order of their first particle; componentCount() of them.
+  const std::vector<std::uint32_t>& components() const { return components_; }
+  std::uint32_t componentCount() const { return componentCount_; }
   /// Mean rest length of the structural springs, m (sizes the self-collision hash and thickness).
   float meanSpacing() const { return meanSpacing_; }
   /// Each particle's share of the rest area (a third of each triangle it belongs to), m^2.
@@ -160,6 +164,7 @@ class Fabric {
   Status finish(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale);
   Status buildTethers(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale);
   void buildTriangleTables();
+  void buildComponents();
 
   float meanSpacing_ = 0.0f;
   Eigen::VectorXf particleAreas_;
@@ -176,6 +181,8 @@ class Fabric {
   int gridColumns_ = 0;
   int gridRows_ = 0;
   float restDiameter_ = 0.0f;
+  std::vector<std::uint32_t> components_;
+  std::uint32_t componentCount_ = 0;
 };
 
 /// The seed's spring count for an n x m King's graph: 4nm - 3(n + m) + 2.

@@ -19,7 +19,10 @@ namespace cape {
 Vec3 windVelocity(const WindSettings& wind, const Vec3& point, double time);
 
 /// The same at many points at once (vectorised), one row per point; `out` must have as many rows as `points`.
-void windVelocities(const WindSettings& wind, const Points& points, double time, Points& out);
+/// The points may be given in a frame whose origin is the world point `origin` (a cape's frame,
+/// Cape::origin): the field is the world's, its phases taken at origin + point in double.
+void windVelocities(const WindSettings& wind, const Points& points, double time, Points& out,
+                    const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
 
 /// The aerodynamic force on one triangle, N (Model::Aerodynamic). `relativeAir` is the air's velocity
 /// relative to the triangle, u (m/s); `areaNormal` is the triangle's normal scaled by its area, A n (m^2;
