@@ -505,7 +505,8 @@ Eigen::Matrix4d toEigen(const aiMatrix4x4& m) {
 
 // The file's triangles' corners, node transforms and scale applied, as distinct points.
 Status readMesh(const std::string& path, const Vec3& scale, const MeshHullOptions& options,
-                std::vector<Vec3>& points, int& triangles) {
+                std::vector<Vec3>& points, int& triangles, bool& overTriangleLimit) {
+  overTriangleLimit = false;
   Assimp::Importer importer;
   // COLLADA: assimp puts the <unit meter> scale and the <up_axis> rotation to its Y-up convention into the
   // root node's transform. URDF consumers (RViz skips the root node's transform and applies <unit meter>
@@ -545,9 +546,12 @@ Status readMesh(const std::string& path, const Vec3& scale, const MeshHullOption
       for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
         const aiFace& face = mesh->mFaces[f];
         if (face.mNumIndices != 3 || face.mIndices == nullptr) continue;  // points and lines
-        if (++triangles > options.maxTriangles)
+        if (triangles >= options.maxTriangles) {
+          overTriangleLimit = true;
           return invalidModel(path, "more than " + std::to_string(options.maxTriangles) +
                                         " triangles (every node instance counted): refused");
+        }
+        ++triangles;
         for (unsigned i = 0; i < 3; ++i) {
           if (face.mIndices[i] >= mesh->mNumVertices)
             return invalidModel(path, "a face index is out of range");
@@ -640,8 +644,9 @@ MeshHullResult loadUncaught(const std::string& path, const Vec3& scale, const Me
   // Read and build outside the lock: other threads' loads go on meanwhile.
   std::vector<Vec3> points;
   auto hull = std::make_shared<MeshHull>();
-  Status status = readMesh(path, scale, options, points, hull->meshTriangles);
-  if (!status.ok()) return {status, nullptr};
+  bool overTriangleLimit = false;
+  Status status = readMesh(path, scale, options, points, hull->meshTriangles, overTriangleLimit);
+  if (!status.ok()) return {status, nullptr, overTriangleLimit};
   hull->meshVertices = static_cast<int>(points.size());
   status = makeHull(path, points, options.maxVertices, *hull);
   if (!status.ok()) return {status, nullptr};

@@ -42,6 +42,9 @@ struct MeshHull {
 struct MeshHullResult {
   Status status;
   std::shared_ptr<const MeshHull> hull;  ///< null unless status is ok
+  /// The file was refused for having more than MeshHullOptions::maxTriangles triangles (counting stops
+  /// there).
+  bool overTriangleLimit = false;
   bool ok() const { return status.ok() && hull != nullptr; }
 };
 

@@ -14,11 +14,14 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
-#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace cape::character {
 
@@ -135,47 +138,157 @@ std::string lower(std::string s) {
   return s;
 }
 
-// urdfdom links own their children through shared pointers: fed a cycle, the links own each other and are
-// never freed (LeakSanitizer says so), whether urdfdom then rejects the model or not. So the joint graph is
-// checked here first, on the XML outline: each link the child of at most one joint, and no loop of parents.
+std::string limitError(const std::string& what, std::size_t count, std::size_t limit, const char* field) {
+  return "URDF has " + std::to_string(count) + " " + what + "; the limit is " + std::to_string(limit) +
+         " (UrdfLimits::" + field + ")";
+}
+
+Status checkLimits(const UrdfLimits& limits) {
+  const std::pair<std::size_t, const char*> fields[] = {{limits.maxFileBytes, "maxFileBytes"},
+                                                        {limits.maxXmlElements, "maxXmlElements"},
+                                                        {limits.maxXmlDepth, "maxXmlDepth"},
+                                                        {limits.maxLinks, "maxLinks"},
+                                                        {limits.maxJoints, "maxJoints"},
+                                                        {limits.maxCollisionElements, "maxCollisionElements"},
+                                                        {limits.maxMeshTriangles, "maxMeshTriangles"}};
+  for (const auto& [value, field] : fields) {
+    if (value < 1)
+      return Status::error(ErrorCode::InvalidArgument, std::string("UrdfLimits::") + field + " is 0");
+  }
+  if (limits.maxXmlDepth > kMaxXmlDepthCeiling) {
+    return Status::error(ErrorCode::InvalidArgument, "UrdfLimits::maxXmlDepth is " +
+                                                         std::to_string(limits.maxXmlDepth) + "; at most " +
+                                                         std::to_string(kMaxXmlDepthCeiling) +
+                                                         " (urdfdom's parser recurses once per level)");
+  }
+  return Status::success();
+}
+
+// The links, joints and collision elements urdfdom and we read (the <robot>'s own <link> and <joint>
+// elements, the links' own <collision> elements), counted against their limits before anything is built.
+Status checkCounts(const std::vector<XmlElement>& outline, const UrdfLimits& limits) {
+  if (outline.empty() || outline[0].name != "robot") return Status::success();
+  std::size_t links = 0, joints = 0, collisions = 0;
+  for (std::size_t i = 1; i < outline.size(); ++i) {
+    const int parent = outline[i].parent;
+    if (parent == 0) {
+      links += outline[i].name == "link" ? 1 : 0;
+      joints += outline[i].name == "joint" ? 1 : 0;
+    } else if (parent > 0 && outline[i].name == "collision") {
+      const XmlElement& up = outline[static_cast<std::size_t>(parent)];
+      collisions += up.name == "link" && up.parent == 0 ? 1 : 0;
+    }
+  }
+  if (links > limits.maxLinks)
+    return Status::error(ErrorCode::InvalidModel, limitError("links", links, limits.maxLinks, "maxLinks"));
+  if (joints > limits.maxJoints)
+    return Status::error(ErrorCode::InvalidModel,
+                         limitError("joints", joints, limits.maxJoints, "maxJoints"));
+  if (collisions > limits.maxCollisionElements) {
+    return Status::error(
+        ErrorCode::InvalidModel,
+        limitError("collision elements", collisions, limits.maxCollisionElements, "maxCollisionElements"));
+  }
+  return Status::success();
+}
+
+// "a -> b -> c -> a" for the cycle through links[0..n), the first 8 and the last 2 when it is longer.
+std::string cyclePath(const std::vector<const std::string*>& links) {
+  constexpr std::size_t kHead = 8, kTail = 2;
+  std::string path;
+  for (std::size_t k = 0; k < links.size(); ++k) {
+    if (links.size() > kHead + kTail && k == kHead) {
+      path += " -> ... (" + std::to_string(links.size() - kHead - kTail) + " more)";
+      k = links.size() - kTail;
+    }
+    path += (k == 0 ? "" : " -> ") + *links[k];
+  }
+  return path + " -> " + *links[0];
+}
+
+// urdfdom links own their children through shared pointers: fed a cycle (a link its own parent included),
+// the links own each other and are never freed (LeakSanitizer says so), whether urdfdom then rejects the
+// model or not. So the joint graph urdfdom would build is checked here first, on the XML outline: every
+// joint of the <robot> names exactly one parent and one child link, each link is the child of at most one
+// joint, and no loop of parents. Link names are compared as urdfdom reads them (urdfdomName, and
+// textForUrdfdom writes them so). Linear in the outline: every link is walked up from at most once.
 Status checkJointGraph(const std::vector<XmlElement>& outline) {
   if (outline.empty() || outline[0].name != "robot")
-    return Status::success();                             // urdfdom will say what is wrong
-  std::unordered_map<std::string, std::string> parentOf;  // child link -> parent link
-  std::unordered_map<std::string, std::string> jointOf;   // child link -> joint
+    return Status::success();                // urdfdom will say what is wrong
+  std::unordered_map<std::string, int> ids;  // link name -> index into the vectors below
+  std::vector<const std::string*> names;     // per link: its name (the key in ids)
+  std::vector<int> parentOf;                 // per link: its parent link, -1 for none
+  std::vector<std::string> jointOf;          // per link: the joint whose child it is
+  const auto idOf = [&](const std::string& name) {
+    const auto [it, added] = ids.emplace(name, static_cast<int>(names.size()));
+    if (added) {
+      names.push_back(&it->first);
+      parentOf.push_back(-1);
+      jointOf.emplace_back();
+    }
+    return it->second;
+  };
   for (std::size_t i = 1; i < outline.size(); ++i) {
     if (outline[i].name != "joint" || outline[i].parent != 0) continue;
-    const std::string* parent = nullptr;
-    const std::string* child = nullptr;
+    const std::string* given = outline[i].attribute("name");
+    const std::string joint = given ? *given : std::string("?");
+    const XmlElement* ends[2] = {nullptr, nullptr};  // its <parent>, its <child>
+    const char* tags[2] = {"parent", "child"};
     for (std::size_t k = i + 1; k < outline.size() && outline[k].parent >= static_cast<int>(i); ++k) {
       if (outline[k].parent != static_cast<int>(i)) continue;
-      if (outline[k].name == "parent") parent = outline[k].attribute("link");
-      if (outline[k].name == "child") child = outline[k].attribute("link");
-    }
-    if (!parent || !child) continue;  // urdfdom reports the incomplete joint
-    const std::string* name = outline[i].attribute("name");
-    const std::string joint = name ? *name : std::string("?");
-    if (parentOf.count(*child) != 0) {
-      return Status::error(ErrorCode::NotATree, "link '" + *child + "' is the child of two joints, '" +
-                                                    jointOf[*child] + "' and '" + joint + "'");
-    }
-    parentOf[*child] = *parent;
-    jointOf[*child] = joint;
-  }
-  // Every loop of parents passes through each of its links, so starting from every link finds every loop.
-  for (const auto& entry : parentOf) {
-    const std::string& start = entry.first;
-    std::string path = start;
-    std::string at = start;
-    for (std::size_t steps = 0; steps <= parentOf.size(); ++steps) {
-      const auto it = parentOf.find(at);
-      if (it == parentOf.end()) break;
-      at = it->second;
-      path += " -> " + at;
-      if (at == start) {
-        return Status::error(ErrorCode::NotATree, "joints form a cycle (child -> parent): " + path);
+      for (int e = 0; e < 2; ++e) {
+        if (outline[k].name != tags[e]) continue;
+        if (ends[e]) {
+          return Status::error(ErrorCode::InvalidModel, "joint '" + joint + "' has more than one <" +
+                                                            tags[e] + "> element; a joint has one parent " +
+                                                            "and one child link");
+        }
+        ends[e] = &outline[k];
       }
     }
+    std::string link[2];
+    for (int e = 0; e < 2; ++e) {
+      if (!ends[e]) {
+        return Status::error(ErrorCode::InvalidModel, "joint '" + joint + "' has no <" + tags[e] +
+                                                          "> element; a joint has one " +
+                                                          "parent and one child link");
+      }
+      const std::string* raw = ends[e]->attribute("link");
+      if (!raw || !urdfdomName(*raw, link[e]) || link[e].empty()) {
+        return Status::error(ErrorCode::InvalidModel, "joint '" + joint + "': its <" + tags[e] +
+                                                          "> element names no link" +
+                                                          (raw ? " (link=\"" + *raw + "\")" : std::string()));
+      }
+    }
+    const int parent = idOf(link[0]), child = idOf(link[1]);
+    if (parentOf[static_cast<std::size_t>(child)] >= 0) {
+      return Status::error(ErrorCode::NotATree, "link '" + link[1] + "' is the child of two joints, '" +
+                                                    jointOf[static_cast<std::size_t>(child)] + "' and '" +
+                                                    joint + "'");
+    }
+    parentOf[static_cast<std::size_t>(child)] = parent;
+    jointOf[static_cast<std::size_t>(child)] = joint;
+  }
+  // Each link has at most one parent, so walking up from a link ends at a root, at a link already known to
+  // lead to one, or back on the walk itself: a cycle. Colours: 0 not seen, 1 on this walk, 2 leads to a root.
+  std::vector<char> colour(names.size(), 0);
+  std::vector<int> walk;
+  for (std::size_t start = 0; start < names.size(); ++start) {
+    walk.clear();
+    int at = static_cast<int>(start);
+    while (at >= 0 && colour[static_cast<std::size_t>(at)] == 0) {
+      colour[static_cast<std::size_t>(at)] = 1;
+      walk.push_back(at);
+      at = parentOf[static_cast<std::size_t>(at)];
+    }
+    if (at >= 0 && colour[static_cast<std::size_t>(at)] == 1) {
+      std::vector<const std::string*> cycle;
+      for (auto k = std::find(walk.begin(), walk.end(), at); k != walk.end(); ++k)
+        cycle.push_back(names[static_cast<std::size_t>(*k)]);
+      return Status::error(ErrorCode::NotATree, "joints form a cycle of " + std::to_string(cycle.size()) +
+                                                    " link(s) (child -> parent): " + cyclePath(cycle));
+    }
+    for (int k : walk) colour[static_cast<std::size_t>(k)] = 2;
   }
   return Status::success();
 }
@@ -369,6 +482,12 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xmlIn, const UrdfLoadOpt
     result.status = Status::error(code, message);
     return result;
   };
+  result.status = checkLimits(options.limits);
+  if (!result.status.ok()) return result;
+  if (xmlIn.size() > options.limits.maxFileBytes) {
+    return fail(ErrorCode::InvalidModel,
+                limitError("bytes", xmlIn.size(), options.limits.maxFileBytes, "maxFileBytes"));
+  }
   // The text ends at its first NUL, as for Bullet's importer (it reads a C string).
   const std::size_t nul = xmlIn.find('\0');
   const std::string xml = nul == std::string::npos ? xmlIn : xmlIn.substr(0, nul);
@@ -379,9 +498,16 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xmlIn, const UrdfLoadOpt
   }
   std::string xmlError;
   std::vector<XmlElement> outline;
-  if (!scanXml(xml, xmlError, &outline)) {
+  XmlScanLimits scanLimits;
+  scanLimits.maxDepth = options.limits.maxXmlDepth;
+  scanLimits.maxElements = options.limits.maxXmlElements;
+  bool tooLarge = false;
+  if (!scanXml(xml, xmlError, &outline, scanLimits, &tooLarge)) {
+    if (tooLarge) return fail(ErrorCode::InvalidModel, "URDF is too large: " + xmlError);
     return fail(ErrorCode::MalformedXml, "URDF is not well-formed XML: " + xmlError);
   }
+  result.status = checkCounts(outline, options.limits);
+  if (!result.status.ok()) return result;
   result.status = checkJointGraph(outline);
   if (!result.status.ok()) return result;
 
@@ -391,7 +517,9 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xmlIn, const UrdfLoadOpt
     return fail(ErrorCode::InvalidArgument, "maxHullVertices is " + std::to_string(options.maxHullVertices) +
                                                 "; a hull needs at least 4");
   }
-  std::unordered_map<std::string, LinkGeometry> geometry = readLinkGeometry(outline, resolved, warnings);
+  std::unordered_map<std::string, LinkGeometry> geometry;
+  result.status = readLinkGeometry(outline, resolved, warnings, geometry);
+  if (!result.status.ok()) return result;
   const std::string clean = textForUrdfdom(xml, outline, warnings);
 
   CapturedConsole console;
@@ -453,10 +581,40 @@ UrdfLoadResult UrdfModel::fromFile(const std::string& path, const UrdfLoadOption
         Status::error(ErrorCode::FileNotFound, "URDF file '" + path + "' does not exist or is not a file");
     return result;
   }
+  result.status = checkLimits(options.limits);
+  if (!result.status.ok()) return result;
+  // The size is checked before the file is read, and the read stops one byte past the limit (the file may
+  // grow meanwhile, or a special file report no size).
+  const std::size_t limit = options.limits.maxFileBytes;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > limit) {
+    result.status = Status::error(
+        ErrorCode::InvalidModel,
+        path + ": " + limitError("bytes", static_cast<std::size_t>(size), limit, "maxFileBytes"));
+    return result;
+  }
   std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  if (!in || !(text << in.rdbuf())) {
+  std::string text;
+  if (in) {
+    text.resize(static_cast<std::size_t>(ec ? 0 : size));
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(in.gcount()));
+    char chunk[65536];
+    while (in && text.size() <= limit) {
+      in.read(chunk,
+              static_cast<std::streamsize>(std::min<std::size_t>(sizeof chunk, limit + 1 - text.size())));
+      text.append(chunk, static_cast<std::size_t>(in.gcount()));
+    }
+  }
+  if (!in && !in.eof()) {
     result.status = Status::error(ErrorCode::FileNotFound, "URDF file '" + path + "' cannot be read");
+    return result;
+  }
+  if (text.size() > limit) {
+    result.status =
+        Status::error(ErrorCode::InvalidModel, path + ": URDF has more than " + std::to_string(limit) +
+                                                   " bytes; the limit is " + std::to_string(limit) +
+                                                   " (UrdfLimits::maxFileBytes)");
     return result;
   }
   UrdfLoadOptions withBase = options;
@@ -464,7 +622,7 @@ UrdfLoadResult UrdfModel::fromFile(const std::string& path, const UrdfLoadOption
     const std::filesystem::path folder = std::filesystem::path(path).parent_path();
     withBase.baseDir = folder.empty() ? std::string(".") : folder.string();
   }
-  result = fromString(text.str(), withBase);
+  result = fromString(text, withBase);
   if (!result.status.ok()) {
     result.status = Status::error(result.status.code(), path + ": " + result.status.message());
   }

@@ -6,8 +6,11 @@
 #include <urdf_model/pose.h>
 #include <urdf_model/utils.h>
 
+#include <algorithm>
 #include <cctype>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 
 namespace cape::character {
@@ -61,6 +64,122 @@ std::string expandEntities(const std::string& s) {
   return out;
 }
 
+// What textForUrdfdom gives urdfdom for a value: runs of white space collapsed and none at the ends when the
+// value has any around it or any tab or line break (urdfdom takes runs of spaces between numbers).
+bool untidy(const std::string& value) {
+  return trim(value) != value || value.find_first_of("\t\n\r") != std::string::npos;
+}
+
+std::string tidied(const std::string& value) {
+  return untidy(value) ? normalised(value) : value;
+}
+
+int hexDigit(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+void appendUtf8(std::uint32_t c, std::string& out) {
+  if (c < 0x80) {
+    out += static_cast<char>(c);
+  } else if (c < 0x800) {
+    out += static_cast<char>(0xC0 | (c >> 6));
+    out += static_cast<char>(0x80 | (c & 0x3F));
+  } else if (c < 0x10000) {
+    out += static_cast<char>(0xE0 | (c >> 12));
+    out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
+    out += static_cast<char>(0x80 | (c & 0x3F));
+  } else {
+    out += static_cast<char>(0xF0 | (c >> 18));
+    out += static_cast<char>(0x80 | ((c >> 12) & 0x3F));
+    out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
+    out += static_cast<char>(0x80 | (c & 0x3F));
+  }
+}
+
+// The five entities XML predefines, and character references (&#N;, &#xH;) as UTF-8; any other '&' stays.
+// False for a character reference that is not a character.
+bool expandReferences(const std::string& s, std::string& out) {
+  static const std::pair<const char*, char> entities[] = {
+      {"&amp;", '&'}, {"&lt;", '<'}, {"&gt;", '>'}, {"&quot;", '"'}, {"&apos;", '\''}};
+  out.clear();
+  for (std::size_t i = 0; i < s.size();) {
+    if (s[i] != '&') {
+      out += s[i++];
+      continue;
+    }
+    if (s.compare(i, 2, "&#") == 0) {
+      const std::size_t semi = s.find(';', i);
+      const bool hex = i + 2 < s.size() && s[i + 2] == 'x';
+      const std::size_t from = i + (hex ? 3 : 2);
+      if (semi == std::string::npos || from >= semi) return false;
+      std::uint32_t c = 0;
+      for (std::size_t k = from; k < semi; ++k) {
+        const int d = hex ? hexDigit(s[k]) : (s[k] >= '0' && s[k] <= '9' ? s[k] - '0' : -1);
+        if (d < 0) return false;
+        c = c * (hex ? 16u : 10u) + static_cast<std::uint32_t>(d);
+        if (c > 0x10FFFF) return false;
+      }
+      if (c == 0 || (c >= 0xD800 && c <= 0xDFFF)) return false;
+      appendUtf8(c, out);
+      i = semi + 1;
+      continue;
+    }
+    bool matched = false;
+    for (const auto& [name, c] : entities) {
+      const std::size_t n = std::char_traits<char>::length(name);
+      if (s.compare(i, n, name) == 0) {
+        out += c;
+        i += n;
+        matched = true;
+        break;
+      }
+    }
+    if (!matched) out += s[i++];
+  }
+  return true;
+}
+
+// `name` written for TinyXML with the five named entities alone.
+std::string escapedForXml(const std::string& name) {
+  std::string out;
+  for (char c : name) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+// Whether attribute a of outline[i] names a link: a top-level <link>'s name, or the link of a top-level
+// <joint>'s <parent> or <child>.
+bool namesALink(const std::vector<XmlElement>& outline, std::size_t i, std::size_t a) {
+  const XmlElement& e = outline[i];
+  const std::string& key = e.attributes[a].first;
+  if (e.parent < 0) return false;
+  const XmlElement& up = outline[static_cast<std::size_t>(e.parent)];
+  if (e.name == "link") return key == "name" && e.parent == 0;
+  return (e.name == "parent" || e.name == "child") && key == "link" && up.name == "joint" && up.parent == 0;
+}
+
 // A vector of exactly `count` numbers (or, with allowOne, one number repeated), as urdfdom reads vectors but
 // with any white space between and around them.
 bool parseNumbers(const std::string& text, int count, bool allowOne, Eigen::Vector3d& out) {
@@ -112,22 +231,23 @@ class GeometryReader {
     }
   }
 
-  std::unordered_map<std::string, LinkGeometry> run() {
-    std::unordered_map<std::string, LinkGeometry> links;
-    if (outline_.empty() || outline_[0].name != "robot") return links;
+  Status run(std::unordered_map<std::string, LinkGeometry>& links) {
+    links.clear();
+    if (outline_.empty() || outline_[0].name != "robot") return Status::success();
     for (std::size_t i : children_[0]) {
       if (outline_[i].name != "link") continue;
       const std::string* name = outline_[i].attribute("name");
       if (!name) continue;  // urdfdom reports a link without a name
-      link_ = *name;
+      if (!urdfdomName(*name, link_)) link_ = *name;
       LinkGeometry& g = links[link_];
       int ordinal = 0;
       for (std::size_t c : children_[i]) {
         if (outline_[c].name == "inertial") readMass(c, g);
         if (outline_[c].name == "collision") readCollision(c, ordinal++, g);
+        if (!fatal_.ok()) return fatal_;
       }
     }
-    return links;
+    return Status::success();
   }
 
  private:
@@ -221,11 +341,31 @@ class GeometryReader {
     std::string path;
     Status s = resolveMeshUri(uri, options_.baseDir, options_.packagePaths, path);
     MeshHullResult loaded;
+    const std::size_t limit = options_.limits.maxMeshTriangles;
     if (s.ok()) {
       MeshHullOptions hullOptions;
       hullOptions.maxVertices = options_.maxHullVertices;
+      // The whole model's budget is the most one mesh may have (the file is not counted past it).
+      hullOptions.maxTriangles = static_cast<int>(std::min<std::size_t>(limit, INT_MAX));
       loaded = loadMeshHull(path, scale, hullOptions);
       s = loaded.status;
+    }
+    const std::string where = "link '" + link_ + "', collision element '" + label + "', mesh '" + uri + "'";
+    const std::string limitIs =
+        "; the limit is " + std::to_string(limit) + " (UrdfLimits::maxMeshTriangles, all meshes together)";
+    if (loaded.overTriangleLimit) {
+      fatal_ = Status::error(ErrorCode::InvalidModel, "URDF mesh at " + where + " alone has more than " +
+                                                          std::to_string(limit) + " triangles" + limitIs);
+      return false;
+    }
+    if (s.ok() && loaded.hull) {
+      triangles_ += static_cast<std::size_t>(loaded.hull->meshTriangles);
+      if (triangles_ > limit) {
+        fatal_ = Status::error(ErrorCode::InvalidModel,
+                               "URDF meshes have at least " + std::to_string(triangles_) +
+                                   " triangles (the limit passed at " + where + ")" + limitIs);
+        return false;
+      }
     }
     if (!s.ok() || !loaded.hull) {
       warn(label, "is a mesh ('" + uri + "') that cannot be used: " + s.message());
@@ -244,6 +384,8 @@ class GeometryReader {
   std::vector<std::string>& warnings_;
   std::vector<std::vector<std::size_t>> children_;
   std::string link_;
+  std::size_t triangles_ = 0;  ///< of the meshes read so far, each element counting its file's
+  Status fatal_;               ///< a limit passed: the reading stops
 };
 
 // The name of the link or joint an element belongs to, for messages.
@@ -271,10 +413,14 @@ bool parseUrdfNumber(const std::string& text, double& value) {
   }
 }
 
-std::unordered_map<std::string, LinkGeometry> readLinkGeometry(const std::vector<XmlElement>& outline,
-                                                               const UrdfLoadOptions& options,
-                                                               std::vector<std::string>& warnings) {
-  return GeometryReader(outline, options, warnings).run();
+Status readLinkGeometry(const std::vector<XmlElement>& outline, const UrdfLoadOptions& options,
+                        std::vector<std::string>& warnings,
+                        std::unordered_map<std::string, LinkGeometry>& links) {
+  return GeometryReader(outline, options, warnings).run(links);
+}
+
+bool urdfdomName(const std::string& raw, std::string& name) {
+  return expandReferences(tidied(raw), name);
 }
 
 std::string textForUrdfdom(const std::string& text, const std::vector<XmlElement>& outline,
@@ -304,11 +450,15 @@ std::string textForUrdfdom(const std::string& text, const std::vector<XmlElement
         clean = "floating";
       } else {
         // Runs of spaces between a vector's numbers are fine for urdfdom; white space around a value, or tabs
-        // and line breaks inside one, are not.
-        const bool untidy = trim(value) != value || value.find_first_of("\t\n\r") != std::string::npos;
-        if (!untidy) continue;
-        clean = normalised(value);
-        if (changed++ == 0) {
+        // and line breaks inside one, are not. A link name with a reference in it is written as we read it,
+        // so that urdfdom's links are joined exactly as our check of the joint graph saw them.
+        const bool spaced = untidy(value);
+        std::string name;
+        const bool named =
+            value.find('&') != std::string::npos && namesALink(outline, i, a) && urdfdomName(value, name);
+        if (!spaced && !named) continue;
+        clean = named ? escapedForXml(name) : normalised(value);
+        if (spaced && changed++ == 0) {
           first =
               "<" + e.name + " " + e.attributes[a].first + "=\"" + value + "\"> of " + ownerOf(outline, i);
         }

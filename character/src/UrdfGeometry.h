@@ -20,17 +20,28 @@ struct LinkGeometry {
   double mass = 0.0;  ///< kg, from <inertial><mass value>; 0 when absent or unreadable
 };
 
-/// Every top-level <link> of the outline by name. Each element that cannot be used (unknown geometry, a
-/// size that is not a positive finite number, a mesh file that is missing, empty or unreadable) is left out
-/// with one warning naming the link, the element and the reason.
-std::unordered_map<std::string, LinkGeometry> readLinkGeometry(const std::vector<XmlElement>& outline,
-                                                               const UrdfLoadOptions& options,
-                                                               std::vector<std::string>& warnings);
+/// Every top-level <link> of the outline by name (as urdfdom reads it, see urdfdomName) into `links`. Each
+/// element that cannot be used (unknown geometry, a size that is not a positive finite number, a mesh file
+/// that is missing, empty or unreadable) is left out with one warning naming the link, the element and the
+/// reason. Fails (InvalidModel) only when the meshes together hold more triangles than
+/// options.limits.maxMeshTriangles; the mesh that passed it is named.
+Status readLinkGeometry(const std::vector<XmlElement>& outline, const UrdfLoadOptions& options,
+                        std::vector<std::string>& warnings,
+                        std::unordered_map<std::string, LinkGeometry>& links);
+
+/// The value urdfdom reads for a link name written as `raw` (a <link name>, or the link of a joint's <parent>
+/// or <child>): white space tidied as textForUrdfdom does, then the references TinyXML expands (&amp; &lt;
+/// &gt; &quot; &apos;, and &#N; &#xH; as UTF-8; any other '&' stays as written). textForUrdfdom writes every
+/// such value that holds a '&' as this name escaped with the five named entities alone, so urdfdom sees
+/// exactly this name whatever its own reading of character references. False for a character reference
+/// that is not a character (0, a surrogate, above U+10FFFF, or not a number).
+bool urdfdomName(const std::string& raw, std::string& name);
 
 /// The text urdfdom is given: without the <collision>, <visual> and <inertial> elements of the links (we read
 /// what we need of them ourselves, and urdfdom drops a link's shapes after one it cannot read), with the
 /// white space around every other attribute value removed (urdfdom refuses " 0.1 " as a number; Bullet's
-/// importer reads it), and `spherical` joints (Bullet's importer's extension) given to urdfdom as `floating`.
+/// importer reads it), link names with a '&' written as urdfdomName reads them, and `spherical` joints
+/// (Bullet's importer's extension) given to urdfdom as `floating`.
 /// One warning says how many values changed and where the first was, one names the spherical joints.
 std::string textForUrdfdom(const std::string& text, const std::vector<XmlElement>& outline,
                            std::vector<std::string>& warnings);

@@ -14,7 +14,10 @@ namespace {
 
 class XmlScanner {
  public:
-  XmlScanner(const std::string& text, std::vector<XmlElement>* outline) : s_(text), outline_(outline) {}
+  XmlScanner(const std::string& text, std::vector<XmlElement>* outline, const XmlScanLimits& limits)
+      : s_(text), outline_(outline), limits_(limits) {}
+
+  bool tooLarge() const { return tooLarge_; }
 
   bool run(std::string& message) {
     if (s_.compare(0, 3, "\xEF\xBB\xBF") == 0) i_ = 3;  // UTF-8 byte order mark
@@ -62,8 +65,16 @@ class XmlScanner {
         element.name = name;
         element.parent = open_.empty() ? -1 : open_.back();
         element.begin = begin;
-        if (stack_.size() >= kMaxXmlDepth) {
-          return fail(message, "elements nested deeper than " + std::to_string(kMaxXmlDepth) + " levels");
+        if (stack_.size() >= limits_.maxDepth) {
+          return fail(message, "elements nested deeper than " + std::to_string(limits_.maxDepth) +
+                                   " levels; the limit is " + std::to_string(limits_.maxDepth) +
+                                   " (UrdfLimits::maxXmlDepth)");
+        }
+        if (++elements_ > limits_.maxElements) {
+          tooLarge_ = true;
+          return fail(message, "more than " + std::to_string(limits_.maxElements) +
+                                   " XML elements; the limit is " + std::to_string(limits_.maxElements) +
+                                   " (UrdfLimits::maxXmlElements)");
         }
         bool selfClosing = false;
         if (!readAttributes(selfClosing, element, message)) return false;
@@ -187,14 +198,20 @@ class XmlScanner {
   std::vector<std::string> stack_;  ///< names of the open elements
   std::vector<int> open_;           ///< their indices in *outline_ (-1 without an outline)
   std::vector<XmlElement>* outline_;
+  XmlScanLimits limits_;
+  std::size_t elements_ = 0;
+  bool tooLarge_ = false;
 };
 
 }  // namespace
 
-bool scanXml(const std::string& text, std::string& message, std::vector<XmlElement>* outline) {
+bool scanXml(const std::string& text, std::string& message, std::vector<XmlElement>* outline,
+             const XmlScanLimits& limits, bool* tooLarge) {
   if (outline) outline->clear();
-  XmlScanner scanner(text, outline);
-  return scanner.run(message);
+  XmlScanner scanner(text, outline, limits);
+  const bool ok = scanner.run(message);
+  if (tooLarge) *tooLarge = scanner.tooLarge();
+  return ok;
 }
 
 bool checkXmlWellFormed(const std::string& text, std::string& message) {

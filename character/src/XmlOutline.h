@@ -18,11 +18,23 @@ struct XmlElement {
   const std::string* attribute(const std::string& key) const;
 };
 
-/// Elements nested deeper than this are refused as malformed: a URDF is a few levels deep, and urdfdom's XML
-/// parser recurses once per level (tens of thousands of levels overflow its stack).
+/// Elements nested deeper than this are refused as malformed by default (UrdfLimits::maxXmlDepth): a URDF is
+/// a few levels deep, and urdfdom's XML parser recurses once per level (tens of thousands of levels overflow
+/// its stack).
 constexpr std::size_t kMaxXmlDepth = 256;
+/// The deepest nesting a user may allow (UrdfLimits::maxXmlDepth): a few hundred KB of urdfdom's stack.
+constexpr std::size_t kMaxXmlDepthCeiling = 1024;
 
-/// checkXmlWellFormed, also filling `outline` (when not null) with every element in document order.
-bool scanXml(const std::string& text, std::string& message, std::vector<XmlElement>* outline);
+/// What the scan refuses (the XML parts of UrdfLimits). Each message names the UrdfLimits field.
+struct XmlScanLimits {
+  std::size_t maxDepth = kMaxXmlDepth;
+  std::size_t maxElements = static_cast<std::size_t>(-1);
+};
+
+/// checkXmlWellFormed, also filling `outline` (when not null) with every element in document order. More
+/// elements than limits.maxElements, or nesting deeper than limits.maxDepth, fail as malformed; `tooLarge`
+/// (when not null) tells the first apart (a limit of the model rather than broken XML).
+bool scanXml(const std::string& text, std::string& message, std::vector<XmlElement>* outline,
+             const XmlScanLimits& limits = {}, bool* tooLarge = nullptr);
 
 }  // namespace cape::character

@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -73,7 +74,34 @@ struct JointDesc {
 class UrdfModel;
 using UrdfModelPtr = std::shared_ptr<const UrdfModel>;
 
-/// How a URDF's mesh collision elements are found and made into hulls.
+/// The most a URDF may hold. A model over a limit is refused before the expensive part of the load, with an
+/// error naming the limit, e.g. "URDF has 10001 links; the limit is 10000 (UrdfLimits::maxLinks)". The
+/// defaults are far above any real robot (the largest public humanoids have about 100 links and a few
+/// collision elements per link) and keep a hostile file's load to seconds and its memory to hundreds of MB.
+/// Each may be set, and every value must be at least 1 (InvalidArgument otherwise).
+struct UrdfLimits {
+  /// Bytes of URDF text (fromString: the whole string; fromFile: the file's size, checked before it is
+  /// read). InvalidModel. Real URDFs are kilobytes to a few MB.
+  std::size_t maxFileBytes = std::size_t(64) << 20;  // 64 MiB
+  /// XML elements of any kind, counted while the text is checked. InvalidModel. Bounds the memory of our
+  /// outline of the text (about 100 bytes per element); a 10,000-link model is some 200,000 elements.
+  std::size_t maxXmlElements = 1000000;
+  /// Nesting depth of the XML elements (a URDF is 5 deep). MalformedXml. At most 1024: urdfdom's parser
+  /// recurses once per level (tens of thousands of levels overflow its stack).
+  std::size_t maxXmlDepth = 256;
+  /// <link> elements of the <robot>. InvalidModel. Each link becomes one rigid body.
+  std::size_t maxLinks = 10000;
+  /// <joint> elements of the <robot>. InvalidModel. A tree of n links has n - 1 joints.
+  std::size_t maxJoints = 10000;
+  /// <collision> elements of all links together. InvalidModel.
+  std::size_t maxCollisionElements = 100000;
+  /// Triangles of all mesh collision elements of the model together: each element counts every triangle of
+  /// its file (every node instance), also when another element uses the same file. InvalidModel. A detailed
+  /// visual mesh is 100,000 to 500,000 triangles; a collision mesh a few thousand.
+  std::size_t maxMeshTriangles = 4000000;
+};
+
+/// How a URDF's mesh collision elements are found and made into hulls, and the limits of what is read.
 struct UrdfLoadOptions {
   /// Folder that relative mesh paths resolve against. fromFile uses the URDF file's folder when empty;
   /// fromString the working directory.
@@ -92,6 +120,9 @@ struct UrdfLoadOptions {
   /// in a T-pose is long along y too, but has no legs either way); either case is said in a warning.
   enum class Up : int { Auto, Z, Y };
   Up modelUp = Up::Auto;
+  /// The most a model may hold (file size, XML depth and elements, links, joints, collision elements, mesh
+  /// triangles).
+  UrdfLimits limits;
 };
 
 /// What a load returns: ok and a model, or an error status and no model. `warnings` holds what was said on
@@ -106,7 +137,8 @@ struct UrdfLoadResult {
 /// Shared and immutable once loaded: any number of Skeletons may use one model.
 class UrdfModel {
  public:
-  /// Reads and parses a URDF file. FileNotFound when the path is not a readable regular file.
+  /// Reads and parses a URDF file. FileNotFound when the path is not a readable regular file; InvalidModel,
+  /// before anything is read, when it is larger than options.limits.maxFileBytes.
   static UrdfLoadResult fromFile(const std::string& path, const UrdfLoadOptions& options = {});
   /// Parses URDF text. The text ends at its first NUL byte, as for Bullet's importer (PyBullet's humanoid
   /// ships with one after </robot>).
@@ -142,8 +174,9 @@ class UrdfModel {
 };
 
 /// Checks that `text` is well-formed XML with a single root element (tags balanced and matched, attributes
-/// quoted, comments, CDATA, processing instructions and a DOCTYPE allowed). On failure `message` says what
-/// and on which line. Used before urdfdom so that broken XML is told apart from a broken robot description.
+/// quoted, comments, CDATA, processing instructions and a DOCTYPE allowed) nested at most
+/// UrdfLimits().maxXmlDepth deep. On failure `message` says what and on which line. Used before urdfdom so
+/// that broken XML is told apart from a broken robot description.
 bool checkXmlWellFormed(const std::string& text, std::string& message);
 
 }  // namespace cape::character
