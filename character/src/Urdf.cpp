@@ -501,9 +501,9 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xmlIn, const UrdfLoadOpt
   XmlScanLimits scanLimits;
   scanLimits.maxDepth = options.limits.maxXmlDepth;
   scanLimits.maxElements = options.limits.maxXmlElements;
-  bool tooLarge = false;
-  if (!scanXml(xml, xmlError, &outline, scanLimits, &tooLarge)) {
-    if (tooLarge) return fail(ErrorCode::InvalidModel, "URDF is too large: " + xmlError);
+  XmlScanDetails scanned;
+  if (!scanXml(xml, xmlError, &outline, scanLimits, &scanned)) {
+    if (scanned.tooLarge) return fail(ErrorCode::InvalidModel, "URDF is too large: " + xmlError);
     return fail(ErrorCode::MalformedXml, "URDF is not well-formed XML: " + xmlError);
   }
   result.status = checkCounts(outline, options.limits);
@@ -520,7 +520,14 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xmlIn, const UrdfLoadOpt
   std::unordered_map<std::string, LinkGeometry> geometry;
   result.status = readLinkGeometry(outline, resolved, warnings, geometry);
   if (!result.status.ok()) return result;
-  const std::string clean = textForUrdfdom(xml, outline, warnings);
+  // What TinyXML would read differently from the outline is blanked (line breaks kept), so that urdfdom
+  // builds the model that was checked: no element hidden in a declaration or a processing instruction.
+  std::string seen = xml;
+  for (const auto& [begin, end] : scanned.endedEarlierByTinyXml) {
+    for (std::size_t k = begin; k < end; ++k)
+      if (seen[k] != '\n') seen[k] = ' ';
+  }
+  const std::string clean = textForUrdfdom(seen, outline, warnings);
 
   CapturedConsole console;
   urdf::ModelInterfaceSharedPtr parsed;

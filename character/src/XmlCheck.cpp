@@ -14,10 +14,9 @@ namespace {
 
 class XmlScanner {
  public:
-  XmlScanner(const std::string& text, std::vector<XmlElement>* outline, const XmlScanLimits& limits)
-      : s_(text), outline_(outline), limits_(limits) {}
-
-  bool tooLarge() const { return tooLarge_; }
+  XmlScanner(const std::string& text, std::vector<XmlElement>* outline, const XmlScanLimits& limits,
+             XmlScanDetails* details)
+      : s_(text), outline_(outline), limits_(limits), details_(details) {}
 
   bool run(std::string& message) {
     if (s_.compare(0, 3, "\xEF\xBB\xBF") == 0) i_ = 3;  // UTF-8 byte order mark
@@ -36,9 +35,13 @@ class XmlScanner {
         if (stack_.empty()) return fail(message, "CDATA outside the root element");
         if (!skipPast("]]>")) return fail(message, "unterminated CDATA section");
       } else if (startsWith("<?")) {
+        const std::size_t begin = i_;
         if (!skipPast("?>")) return fail(message, "unterminated processing instruction");
+        noteIfEndedEarlier(begin);
       } else if (startsWith("<!")) {
+        const std::size_t begin = i_;
         if (!skipDeclaration()) return fail(message, "unterminated <! declaration");
+        noteIfEndedEarlier(begin);
       } else if (startsWith("</")) {
         advance(2);
         const std::string name = readName();
@@ -71,7 +74,7 @@ class XmlScanner {
                                    " (UrdfLimits::maxXmlDepth)");
         }
         if (++elements_ > limits_.maxElements) {
-          tooLarge_ = true;
+          if (details_) details_->tooLarge = true;
           return fail(message, "more than " + std::to_string(limits_.maxElements) +
                                    " XML elements; the limit is " + std::to_string(limits_.maxElements) +
                                    " (UrdfLimits::maxXmlElements)");
@@ -101,6 +104,11 @@ class XmlScanner {
     for (std::size_t k = 0; k < n && i_ < s_.size(); ++k, ++i_) {
       if (s_[i_] == '\n') ++line_;
     }
+  }
+
+  // A processing instruction or <! declaration from `begin` to here that TinyXML ends at an earlier '>'.
+  void noteIfEndedEarlier(std::size_t begin) {
+    if (details_ && s_.find('>', begin) + 1 < i_) details_->endedEarlierByTinyXml.emplace_back(begin, i_);
   }
 
   bool skipPast(const char* end) {
@@ -199,19 +207,18 @@ class XmlScanner {
   std::vector<int> open_;           ///< their indices in *outline_ (-1 without an outline)
   std::vector<XmlElement>* outline_;
   XmlScanLimits limits_;
+  XmlScanDetails* details_;
   std::size_t elements_ = 0;
-  bool tooLarge_ = false;
 };
 
 }  // namespace
 
 bool scanXml(const std::string& text, std::string& message, std::vector<XmlElement>* outline,
-             const XmlScanLimits& limits, bool* tooLarge) {
+             const XmlScanLimits& limits, XmlScanDetails* details) {
   if (outline) outline->clear();
-  XmlScanner scanner(text, outline, limits);
-  const bool ok = scanner.run(message);
-  if (tooLarge) *tooLarge = scanner.tooLarge();
-  return ok;
+  if (details) *details = XmlScanDetails();
+  XmlScanner scanner(text, outline, limits, details);
+  return scanner.run(message);
 }
 
 bool checkXmlWellFormed(const std::string& text, std::string& message) {

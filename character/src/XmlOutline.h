@@ -31,10 +31,21 @@ struct XmlScanLimits {
   std::size_t maxElements = static_cast<std::size_t>(-1);
 };
 
-/// checkXmlWellFormed, also filling `outline` (when not null) with every element in document order. More
-/// elements than limits.maxElements, or nesting deeper than limits.maxDepth, fail as malformed; `tooLarge`
-/// (when not null) tells the first apart (a limit of the model rather than broken XML).
+/// What else the scan found out.
+struct XmlScanDetails {
+  /// The scan failed on limits.maxElements: a limit of the model rather than broken XML.
+  bool tooLarge = false;
+  /// [begin, end) of each processing instruction and <! declaration that holds a '>' before its own end (a
+  /// DOCTYPE with an internal subset, a PI with a '>' inside). urdfdom's parser (TinyXML) ends those at
+  /// their first '>' and reads what follows as markup, elements the outline does not have; so the loader
+  /// blanks them out of the text urdfdom is given.
+  std::vector<std::pair<std::size_t, std::size_t>> endedEarlierByTinyXml;
+};
+
+/// checkXmlWellFormed, also filling `outline` (when not null) with every element in document order and
+/// `details` (when not null). More elements than limits.maxElements, or nesting deeper than
+/// limits.maxDepth, fail as malformed.
 bool scanXml(const std::string& text, std::string& message, std::vector<XmlElement>* outline,
-             const XmlScanLimits& limits = {}, bool* tooLarge = nullptr);
+             const XmlScanLimits& limits = {}, XmlScanDetails* details = nullptr);
 
 }  // namespace cape::character

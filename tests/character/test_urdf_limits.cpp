@@ -347,3 +347,23 @@ TEST_F(UrdfLimitsFiles, MeshTrianglesOfTheWholeModelOverTheLimitAreRefusedNaming
       << alone.status.message();
   EXPECT_TRUE(has(alone.status.message(), "(UrdfLimits::maxMeshTriangles")) << alone.status.message();
 }
+
+TEST(UrdfLimits, ElementsHiddenInADeclarationOrAProcessingInstructionAreNotReadByUrdfdom) {
+  // Each ends, for TinyXML (urdfdom's parser), at its first '>', and what follows would be read as markup:
+  // here a joint that makes link 'a' its own parent (which urdfdom would leak). The check skips them whole,
+  // and so does urdfdom now: each model is the one link.
+  const std::string selfLoop = R"(<joint name="j" type="fixed"><parent link="a"/><child link="a"/></joint>)";
+  const std::string texts[] = {R"(<robot name="r"><link name="a"/><?pi >)" + selfLoop + R"( ?></robot>)",
+                               R"(<robot name="r"><link name="a"/><!X [>)" + selfLoop + R"(]></robot>)",
+                               R"(<!DOCTYPE r [<!ELEMENT r ANY><robot name="fake"><link name="a"/>)" +
+                                   selfLoop +
+                                   R"(</robot>]>
+<robot name="r"><link name="a"/></robot>)"};
+  for (const std::string& text : texts) {
+    const UrdfLoadResult r = UrdfModel::fromString(text);
+    ASSERT_TRUE(r.ok()) << text << ": " << r.status.message();
+    EXPECT_EQ(r.model->name(), "r");
+    EXPECT_EQ(r.model->links().size(), 1u);
+    EXPECT_TRUE(r.model->joints().empty());
+  }
+}
