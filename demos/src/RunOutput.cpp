@@ -1,5 +1,7 @@
 #include "RunOutput.h"
 
+#include <algorithm>
+#include <cinttypes>
 #include <cstdio>
 #include <ctime>
 #include <stdexcept>
@@ -141,26 +143,26 @@ RunWriter::RunWriter(const fs::path& dir, bool writeFrames, int characters)
 
 void RunWriter::frame(const FrameRow& r) {
   char line[512];
-  std::snprintf(line, sizeof line, "%d,%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%.5f,%d\n", r.frame, r.time,
-                r.frameTimeUs, r.capeTimeUs, r.metrics.maxStrain, r.metrics.meanStrain,
+  std::snprintf(line, sizeof line, "%" PRId64 ",%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%.5f,%d\n", r.frame,
+                r.time, r.frameTimeUs, r.capeTimeUs, r.metrics.maxStrain, r.metrics.meanStrain,
                 r.metrics.maxPenetration, r.metrics.selfIntersections, r.metrics.pinError,
                 r.metrics.meanSpeed, r.metrics.blowUp ? 1 : 0);
   csv_ << line;
 }
 
-void RunWriter::capeMesh(int frame, int character, const Cape& cape) {
+void RunWriter::capeMesh(std::int64_t frame, int character, const Cape& cape) {
   if (!writeFrames_) return;
   if (mesh_.positions.rows() != static_cast<Eigen::Index>(cape.fabric().particleCount()))
     mesh_.allocate(cape.fabric(), false);
   mesh_.update(cape.fabric(), cape.state().positions);
   char name[32];
-  std::snprintf(name, sizeof name, "%05d.obj", frame);
+  std::snprintf(name, sizeof name, "%05" PRId64 ".obj", frame);
   const fs::path folder =
       characters_ > 1 ? dir_ / "frames" / ("k" + std::to_string(character)) : dir_ / "frames";
   writeObj(folder / name, mesh_, cape.fabric().particleCount());
 }
 
-void RunWriter::colliders(int frame, const std::vector<Collider>& colliders) {
+void RunWriter::colliders(std::int64_t frame, const std::vector<Collider>& colliders) {
   json j;
   j["frame"] = frame;
   j["colliders"] = json::array();
@@ -174,18 +176,19 @@ void RunWriter::summary(const json& s) {
   if (!out) throw std::runtime_error("cannot write " + (dir_ / "summary.json").string());
 }
 
-json summaryFigures(const std::vector<FrameRow>& rows, const RunSummary& q) {
-  std::vector<double> frameTimes, capeTimes;
-  for (std::size_t i = 10; i < rows.size(); ++i) {  // frames 11..end
-    frameTimes.push_back(rows[i].frameTimeUs);
-    capeTimes.push_back(rows[i].capeTimeUs);
-  }
+void FrameTimings::add(const FrameRow& row) {
+  if (row.frame <= 10) return;  // frames 11..end
+  frameTimeUs_.add(row.frameTimeUs);
+  capeTimeUs_.add(row.capeTimeUs);
+}
+
+json summaryFigures(const FrameTimings& timings, const RunSummary& q) {
   json j;
   j["frames"] = q.frames;
-  j["frame_time_us_median"] = percentile(frameTimes, 50.0);
-  j["frame_time_us_p95"] = percentile(frameTimes, 95.0);
-  j["cape_time_us_median"] = percentile(capeTimes, 50.0);
-  j["cape_time_us_p95"] = percentile(capeTimes, 95.0);
+  j["frame_time_us_median"] = timings.frameTimeUs().percentile(50.0);
+  j["frame_time_us_p95"] = timings.frameTimeUs().percentile(95.0);
+  j["cape_time_us_median"] = timings.capeTimeUs().percentile(50.0);
+  j["cape_time_us_p95"] = timings.capeTimeUs().percentile(95.0);
   j["max_strain"] = q.maxStrain;
   j["mean_strain"] = q.meanStrain;
   j["median_frame_max_strain"] = q.medianFrameMaxStrain;
@@ -198,6 +201,129 @@ json summaryFigures(const std::vector<FrameRow>& rows, const RunSummary& q) {
   j["rest_jitter_mps"] = q.restJitter;
   j["blow_up"] = q.blowUp;
   return j;
+}
+
+namespace {
+
+bool isFrameObj(const fs::path& name) {
+  const std::string n = name.string();
+  if (n.size() < 9 || n.compare(n.size() - 4, 4, ".obj") != 0) return false;
+  return std::all_of(n.begin(), n.end() - 4, [](char c) { return c >= '0' && c <= '9'; });
+}
+
+bool isCharacterFolder(const fs::path& name) {
+  const std::string n = name.string();
+  return n.size() >= 2 && n[0] == 'k' &&
+         std::all_of(n.begin() + 1, n.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+bool isRunFile(const fs::path& name, RunFolderKind kind) {
+  static const char* const walk[] = {"metrics.csv", "summary.json", "colliders.jsonl"};
+  static const char* const compare[] = {"compare.csv",           "compare.json",          "frames_ours.csv",
+                                        "frames_btsoftbody.csv", "frames_deformable.csv", "strain.png",
+                                        "penetration.png",       "frame_time.png"};
+  const std::string n = name.string();
+  if (kind == RunFolderKind::Walk) return std::find(std::begin(walk), std::end(walk), n) != std::end(walk);
+  return std::find(std::begin(compare), std::end(compare), n) != std::end(compare);
+}
+
+/// The previous run's files in `dir` (each folder after its files, so that it is empty when deleted), or
+/// false and the reason when anything else is there.
+bool listRunFiles(const fs::path& dir, RunFolderKind kind, std::vector<fs::path>& files, std::string& error) {
+  // Only what the demo makes: regular files and (for frames) real folders, never a symbolic link. An entry
+  // that cannot be read is neither, so it is refused.
+  const auto type = [](const fs::path& p) {
+    std::error_code unreadable;
+    return fs::symlink_status(p, unreadable).type();
+  };
+  const auto isFile = [&](const fs::path& p) { return type(p) == fs::file_type::regular; };
+  const auto isFolder = [&](const fs::path& p) { return type(p) == fs::file_type::directory; };
+  std::vector<fs::path> strangers;
+  std::error_code ec;
+  const auto objFolder = [&](const fs::path& folder, bool characters) {
+    for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
+      const fs::path name = e.path().filename();
+      if (isFile(e.path()) && isFrameObj(name)) {
+        files.push_back(e.path());
+      } else if (characters && isFolder(e.path()) && isCharacterFolder(name)) {
+        for (const fs::directory_entry& f : fs::directory_iterator(e.path(), ec)) {
+          if (isFile(f.path()) && isFrameObj(f.path().filename()))
+            files.push_back(f.path());
+          else
+            strangers.push_back(f.path());
+        }
+        files.push_back(e.path());
+      } else {
+        strangers.push_back(e.path());
+      }
+    }
+  };
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const fs::path name = e.path().filename();
+    if (isFile(e.path()) && isRunFile(name, kind)) {
+      files.push_back(e.path());
+    } else if (kind == RunFolderKind::Walk && name == "frames" && isFolder(e.path())) {
+      objFolder(e.path(), true);
+      files.push_back(e.path());
+    } else {
+      strangers.push_back(e.path());
+    }
+  }
+  if (ec) {
+    error = "cannot read --out " + dir.string() + ": " + ec.message();
+    return false;
+  }
+  if (strangers.empty()) return true;
+  std::sort(strangers.begin(), strangers.end());
+  const char* demo = kind == RunFolderKind::Walk ? "cape_walk" : "cape_compare";
+  const std::size_t more = strangers.size() - 1;
+  error = "--out " + dir.string() + " holds " + fs::relative(strangers.front(), dir, ec).string() +
+          (more > 0 ? " (and " + std::to_string(more) + " more)" : "") + ", which " + demo +
+          " does not write: give a new or empty folder, or one that holds nothing but a previous " + demo +
+          " run (whose files are then deleted)";
+  return false;
+}
+
+}  // namespace
+
+bool checkOutFolder(const fs::path& dir, RunFolderKind kind, std::string& error) try {
+  std::error_code ec;
+  const fs::file_status status = fs::status(dir, ec);
+  if (status.type() == fs::file_type::not_found) return true;
+  if (ec) {
+    error = "cannot read --out " + dir.string() + ": " + ec.message();
+    return false;
+  }
+  if (!fs::is_directory(status)) {
+    error = "--out " + dir.string() + " is not a folder";
+    return false;
+  }
+  std::vector<fs::path> files;
+  return listRunFiles(dir, kind, files, error);
+} catch (const fs::filesystem_error& e) {
+  error = "cannot read --out " + dir.string() + ": " + e.what();
+  return false;
+}
+
+bool prepareOutFolder(const fs::path& dir, RunFolderKind kind, std::string& error) try {
+  if (!checkOutFolder(dir, kind, error)) return false;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  std::vector<fs::path> files;
+  if (ec || !listRunFiles(dir, kind, files, error)) {
+    if (ec) error = "cannot create output folder " + dir.string() + ": " + ec.message();
+    return false;
+  }
+  for (const fs::path& f : files) {
+    if (!fs::remove(f, ec) || ec) {
+      error = "cannot delete the previous run's " + f.string() + (ec ? ": " + ec.message() : "");
+      return false;
+    }
+  }
+  return true;
+} catch (const fs::filesystem_error& e) {
+  error = "cannot empty --out " + dir.string() + ": " + e.what();
+  return false;
 }
 
 fs::path freshRunFolder(const std::string& scene, const std::string& prefix) {

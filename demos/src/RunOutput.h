@@ -1,8 +1,9 @@
 // What a run writes to its output folder (see the README, "Reading the outputs"):
 //   metrics.csv      one row per frame with every metric of docs/SCENES.md
 //   summary.json     scene, settings, grid and cape dimensions, summary figures
-//   frames/NNNNN.obj the cape mesh of each frame (frames/kK/NNNNN.obj per character in a crowd)
-//   colliders.jsonl  one JSON object per frame with every body collider
+//   frames/NNNNN.obj the cape mesh of each kept frame (frames/kK/NNNNN.obj per character in a crowd)
+//   colliders.jsonl  one JSON object per kept frame with every body collider
+// and how a demo takes its --out folder (checkOutFolder, prepareOutFolder).
 #pragma once
 
 #include "cape/core/CapeMesh.h"
@@ -10,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -19,7 +21,7 @@ namespace cape::demo {
 
 /// One row of metrics.csv (for a crowd: the worst over its characters).
 struct FrameRow {
-  int frame = 0;
+  std::int64_t frame = 0;
   double time = 0.0;         ///< s, at the end of the frame
   double frameTimeUs = 0.0;  ///< wall time of the whole frame step
   double capeTimeUs = 0.0;   ///< the cape solver's share
@@ -40,8 +42,8 @@ class RunWriter {
   /// Creates the folder (and frames/ unless writeFrames is false). Throws std::runtime_error if it cannot.
   RunWriter(const std::filesystem::path& dir, bool writeFrames, int characters);
   void frame(const FrameRow& row);
-  void capeMesh(int frame, int character, const Cape& cape);
-  void colliders(int frame, const std::vector<Collider>& colliders);
+  void capeMesh(std::int64_t frame, int character, const Cape& cape);
+  void colliders(std::int64_t frame, const std::vector<Collider>& colliders);
   void summary(const nlohmann::json& summary);
   const std::filesystem::path& dir() const { return dir_; }
 
@@ -54,8 +56,36 @@ class RunWriter {
   CapeMesh mesh_;
 };
 
-/// Summary figures of a run, the timings over frames 11..end as docs/SCENES.md defines them.
-nlohmann::json summaryFigures(const std::vector<FrameRow>& rows, const RunSummary& quality);
+/// The frame and cape times of a run over frames 11..end, as docs/SCENES.md defines them, in constant memory.
+class FrameTimings {
+ public:
+  void add(const FrameRow& row);
+  const PercentileEstimator& frameTimeUs() const { return frameTimeUs_; }
+  const PercentileEstimator& capeTimeUs() const { return capeTimeUs_; }
+
+ private:
+  PercentileEstimator frameTimeUs_, capeTimeUs_;
+};
+
+/// Summary figures of a run: its timings' median and p95 and the quality summary.
+nlohmann::json summaryFigures(const FrameTimings& timings, const RunSummary& quality);
+
+/// Which demo's files an output folder holds.
+enum class RunFolderKind {
+  Walk,     ///< cape_walk: metrics.csv, summary.json, colliders.jsonl, frames/[kK/]NNNNN.obj
+  Compare,  ///< cape_compare: compare.csv, compare.json, frames_*.csv, strain.png, penetration.png,
+            ///< frame_time.png
+};
+
+/// Whether `dir` can take a run of `kind`, checked before any work: a folder that does not exist yet, an
+/// empty one, or one that holds nothing but files that kind of run writes (a previous run, finished or
+/// not). False with the reason for anything else: a file, a folder with any other file or folder in it
+/// (nothing is deleted then), or one that cannot be read.
+bool checkOutFolder(const std::filesystem::path& dir, RunFolderKind kind, std::string& error);
+
+/// Makes `dir` (as checkOutFolder accepts it) and deletes the previous run's files in it, so that the new
+/// run's are all it holds. False with the reason if that fails.
+bool prepareOutFolder(const std::filesystem::path& dir, RunFolderKind kind, std::string& error);
 
 /// A fresh folder name in the current directory: <prefix>_<scene>_<YYYYmmdd-HHMMSS>[-N].
 std::filesystem::path freshRunFolder(const std::string& scene, const std::string& prefix = "cape_run");

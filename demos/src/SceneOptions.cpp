@@ -1,5 +1,7 @@
 #include "SceneOptions.h"
 
+#include "CliNumbers.h"
+
 #include "cape/character/Character.h"
 
 #include <cmath>
@@ -11,15 +13,17 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
       ->check(CLI::IsMember({"hang", "walk", "sprint-turn", "wind", "crowd"}))
       ->capture_default_str();
   app.add_option("--size", cli.size, "particles per side of the N x N cape")
-      ->check(CLI::Range(2, 256))
+      ->transform(strictInteger(2, 256))
       ->capture_default_str();
   app.add_option("--attachment", cli.attachment, "corners (the two top corners) | collar (the whole top row)")
       ->check(CLI::IsMember({"corners", "collar"}))
       ->capture_default_str();
-  app.add_option("--seconds", cli.seconds, "simulated length, s (default: the scene's own length)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--seconds", cli.seconds,
+                 "simulated length, s, up to 24 h, rounded to whole 1/60 s frames (default: the scene's "
+                 "own length)")
+      ->transform(strictReal(kMinSeconds, kMaxSeconds));
   app.add_option("--characters", cli.characters, "characters in the crowd scene")
-      ->check(CLI::Range(1, 64))
+      ->transform(strictInteger(1, 64))
       ->capture_default_str();
   app.add_flag("--simple-body", cli.simpleBody,
                "use the simple body of docs/SCENES.md instead of a URDF character");
@@ -36,7 +40,8 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
       ->capture_default_str();
   app.add_option("--root-height", cli.rootHeight,
                  "height of the URDF's root link above the ground, m (default: its lowest collision point "
-                 "touches the ground)");
+                 "touches the ground)")
+      ->transform(strictReal(-kMaxRootHeight, kMaxRootHeight));
   app.add_option("--model-up", cli.modelUp,
                  "the axis the URDF model stands along in its file: auto (z, with a warning when it looks "
                  "Y-up) | z (REP 103) | y (Y-up tools, e.g. PyBullet's DeepMimic humanoid)")
@@ -44,10 +49,14 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
       ->capture_default_str();
   app.add_option("--scale", cli.scale,
                  "uniform scale of the URDF model (e.g. 0.25 for a model in other units)")
-      ->check(CLI::Range(1e-3, 1e3))
+      ->transform(strictReal(1e-3, 1e3))
       ->capture_default_str();
   app.add_option("--pose", cli.pose,
                  "starting joint positions, rad (or m): name=value,name=value; the gait moves from there");
+  app.add_option("--origin", cli.origin,
+                 "starts the scene at this world position, m: X,Y,Z (default 0,0,0; where the character "
+                 "starts)")
+      ->check(strictVector3(kMaxOrigin));
 }
 
 bool toRunOptions(const SceneCli& cli, RunOptions& o, std::string& error) {
@@ -69,6 +78,13 @@ bool toRunOptions(const SceneCli& cli, RunOptions& o, std::string& error) {
   if (o.rootHeight && !std::isfinite(*o.rootHeight)) {
     error = "--root-height must be a finite number of metres";
     return false;
+  }
+  if (!cli.origin.empty()) {
+    const std::string why = parseVector3(cli.origin, kMaxOrigin, o.origin);
+    if (!why.empty()) {
+      error = "--origin: " + why;
+      return false;
+    }
   }
   parseSceneKind(cli.scene, o.scene);
   parsePinLayout(cli.attachment, o.pinLayout);

@@ -5,11 +5,21 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace cape::demo {
+
+/// The ranges of the shared options (each refused outside it, before any work starts).
+constexpr double kMinSeconds = 0.01;          ///< --seconds, s: rounds to one 1/60 s frame
+constexpr double kMaxSeconds = 86400.0;       ///< --seconds, s: 24 h of simulated time, 5,184,000 frames
+constexpr double kMaxRootHeight = 1e3;        ///< |--root-height|, m
+constexpr double kMaxOrigin = 1e7;            ///< |X|, |Y|, |Z| of --origin, m
+constexpr std::int64_t kMaxFrames = 5184000;  ///< 1/60 s frames in kMaxSeconds (--frames-every's bound)
+constexpr int kMinImageSide = 16;             ///< --render-size, px (each side even, for the H.264 video)
+constexpr int kMaxImageSide = 4096;
 
 struct SceneCli {
   std::string scene = "walk";
@@ -26,14 +36,16 @@ struct SceneCli {
   std::string pose;  ///< name=rad,name=rad,...
   std::string modelUp = "auto";
   double scale = 1.0;
+  std::string origin;  ///< X,Y,Z, m; empty: the world's origin
 };
 
 /// Adds --scene, --size, --attachment, --seconds, --characters, --simple-body, --urdf, --attach,
-/// --package-path, --up, --root-height, --pose, --model-up and --scale.
+/// --package-path, --up, --root-height, --pose, --model-up, --scale and --origin; every number read strictly
+/// (CliNumbers.h) within the ranges above or the option's own.
 void addSceneOptions(CLI::App& app, SceneCli& cli);
 
 /// The run options they ask for (the attachment links split at commas; one character unless the crowd).
-/// False and a message when --pose cannot be read.
+/// False and a message when --pose or --origin cannot be read.
 bool toRunOptions(const SceneCli& cli, RunOptions& options, std::string& error);
 
 }  // namespace cape::demo

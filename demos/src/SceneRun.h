@@ -7,6 +7,8 @@
 #include "cape/scenes/Metrics.h"
 #include "cape/scenes/Scene.h"
 
+#include <Eigen/Core>
+
 #include <memory>
 #include <optional>
 #include <string>
@@ -34,6 +36,7 @@ struct RunOptions {
   std::vector<std::pair<std::string, double>> pose;  ///< the character's starting joint positions by name
   character::UrdfLoadOptions::Up modelUp = character::UrdfLoadOptions::Up::Auto;  ///< the model's own up
   double scale = 1.0;                                                             ///< of the URDF model
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< m: the world position where the character starts
 };
 
 class SceneRun {

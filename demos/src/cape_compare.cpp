@@ -4,6 +4,7 @@
 // time relative to ours; writes compare.csv, compare.json,
 // per-frame CSVs and PNG plots. `cape_compare --help` lists the options.
 #include "BulletScene.h"
+#include "CliNumbers.h"
 #include "Plots.h"
 #include "Progress.h"
 #include "Renderer.h"
@@ -17,6 +18,7 @@
 #include <BulletSoftBody/btSoftBody.h>
 #include <CLI/CLI.hpp>
 
+#include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -27,12 +29,64 @@ using nlohmann::json;
 
 namespace {
 
-/// One solver's run: per-frame metrics and timings, and its settings as printed.
+/// A solver's lines of the plots in bounded memory: every frame's point until kPoints are kept, then every
+/// second frame's, every fourth, ... (each time the lines fill up, every other point is dropped).
+class PlotPoints {
+ public:
+  static constexpr std::size_t kPoints = 4096;
+  void add(const FrameRow& r) {
+    if (r.frame % stride_ != 0) return;
+    if (frames_.size() == kPoints) {
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < frames_.size(); ++i) {
+        if (frames_[i] % (2 * stride_) != 0) continue;
+        frames_[kept] = frames_[i];
+        for (std::vector<double>& v : values_) v[kept] = v[i];
+        ++kept;
+      }
+      frames_.resize(kept);
+      for (std::vector<double>& v : values_) v.resize(kept);
+      stride_ *= 2;
+      if (r.frame % stride_ != 0) return;
+    }
+    frames_.push_back(r.frame);
+    values_[0].push_back(100.0 * r.metrics.maxStrain);
+    values_[1].push_back(1000.0 * r.metrics.maxPenetration);
+    values_[2].push_back(r.frameTimeUs);
+  }
+  /// Line `which`: 0 max strain, %; 1 penetration, mm; 2 frame time, us; against time, s.
+  Series series(const std::string& name, int which) const {
+    Series s{name, {}, values_[static_cast<std::size_t>(which)]};
+    for (std::int64_t f : frames_) s.x.push_back(static_cast<double>(f) / 60.0);
+    return s;
+  }
+
+ private:
+  std::int64_t stride_ = 1;
+  std::vector<std::int64_t> frames_;
+  std::vector<double> values_[3];
+};
+
+/// One solver's run: its summary, timings, plotted points and per-frame CSV (written as it runs), and its
+/// settings as printed.
 struct SolverResult {
   std::string name;
   json settings;
-  std::vector<FrameRow> rows;
   MetricsRecorder recorder;
+  FrameTimings timings;
+  PlotPoints plot;
+  std::ofstream perFrame;
+  void add(const FrameRow& r) {
+    recorder.add(r.metrics);
+    timings.add(r);
+    plot.add(r);
+    char line[512];
+    std::snprintf(line, sizeof line, "%" PRId64 ",%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%d\n", r.frame,
+                  r.time, r.frameTimeUs, r.capeTimeUs, r.metrics.maxStrain, r.metrics.meanStrain,
+                  r.metrics.maxPenetration, r.metrics.selfIntersections, r.metrics.pinError,
+                  r.metrics.blowUp ? 1 : 0);
+    perFrame << line;
+  }
 };
 
 /// The twins of every character of a scene, in a world of their own: btSoftBody twins in a soft-rigid world,
@@ -161,7 +215,11 @@ int main(int argc, char** argv) {
       "cape_compare: the same scene with our cape and with Bullet's btSoftBody twin (and, with "
       "--with-deformable, its deformable-world twin), side by side; prints every metric of docs/SCENES.md "
       "per "
-      "solver and writes compare.csv, compare.json and PNG plots."};
+      "solver and writes compare.csv, compare.json and PNG plots. Every number is read whole and checked "
+      "against its range before the run starts."};
+  app.footer(
+      "Exit status: 0 when the run is done; 1 when the URDF, the settings or the output cannot be used; "
+      "CLI11's codes (from 100; 105 for a number out of range or not a number) for a bad command line.");
   SceneCli sceneCli;
   std::string out;
   int iterations = 10;
@@ -171,21 +229,26 @@ int main(int argc, char** argv) {
   std::string render, renderSize = "960x360";
   addSceneOptions(app, sceneCli);
   app.add_option("--softbody-iterations", iterations, "btSoftBody position iterations (m_cfg.piterations)")
-      ->check(CLI::Range(1, 200))
+      ->transform(strictInteger(1, 200))
       ->capture_default_str();
-  app.add_option("--out", out, "output folder (default: a fresh cape_compare_<scene>_<time> folder)");
+  app.add_option("--out", out,
+                 "output folder (default: a fresh cape_compare_<scene>_<time> folder). A folder that holds "
+                 "a previous cape_compare run (only compare.csv, compare.json, frames_*.csv and the three "
+                 "plots) is emptied of it first; a folder with any other file is refused and left as it is");
   app.add_flag("--no-plots", noPlots, "do not draw the PNG plots");
   app.add_flag("--with-deformable", withDeformable,
                "also run the twin in Bullet's deformable world (btDeformableMultiBodyDynamicsWorld)");
   app.add_option("--deformable-stiffness", deformableStiffness,
                  "the deformable twin's spring stiffness, N/m (from 100 it blows up on the 20 x 20 cape)")
-      ->check(CLI::PositiveNumber)
+      ->transform(strictReal(1e-3, 1e6))
       ->capture_default_str();
   app.add_option(
       "--render", render,
       "also render both capes side by side (ours left, btSoftBody right) as PNG frames, and run.mp4 and "
       "run.gif with ffmpeg, into this folder");
-  app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
+  app.add_option("--render-size", renderSize, "rendered image size, WxH")
+      ->check(strictImageSize(kMinImageSide, kMaxImageSide, true))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   RunOptions o;
@@ -196,6 +259,13 @@ int main(int argc, char** argv) {
   }
   const std::string& scene = sceneCli.scene;
   const int size = sceneCli.size;
+  const std::filesystem::path dir =
+      out.empty() ? freshRunFolder(scene, "cape_compare") : std::filesystem::path(out);
+  std::string error;
+  if (!checkOutFolder(dir, RunFolderKind::Compare, error)) {
+    std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
+    return 1;
+  }
 
   // The twin's settings: the same masses, springs (structural + shear, the King's graph; bend springs
   // soften btSoftBody's stretch resistance and are left out), friction, thickness and air drag as ours
@@ -210,7 +280,6 @@ int main(int argc, char** argv) {
   twin.friction = btScalar(o.settings.friction);
   twin.margin = btScalar(o.settings.collisionThickness);
 
-  std::string error;
   std::unique_ptr<SceneRun> ours = makeSceneRun(o, error);
   if (!ours) {
     std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
@@ -242,12 +311,8 @@ int main(int argc, char** argv) {
   }
   TwinRun& twinRun = twinRuns[0];
 
-  const std::filesystem::path dir =
-      out.empty() ? freshRunFolder(scene, "cape_compare") : std::filesystem::path(out);
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) {
-    std::fprintf(stderr, "cape_compare: cannot create %s: %s\n", dir.c_str(), ec.message().c_str());
+  if (!prepareOutFolder(dir, RunFolderKind::Compare, error)) {
+    std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
     return 1;
   }
 
@@ -256,10 +321,7 @@ int main(int argc, char** argv) {
   CapeMesh twinMesh;
   if (!render.empty()) {
     int w = 0, h = 0;
-    if (std::sscanf(renderSize.c_str(), "%dx%d", &w, &h) != 2) {
-      std::fprintf(stderr, "cape_compare: --render-size %s is not WxH\n", renderSize.c_str());
-      return 1;
-    }
+    parseImageSize(renderSize, kMinImageSide, kMaxImageSide, true, w, h);  // checked by CLI11
     renderer = std::make_unique<RunRenderer>(render, 2, w, h, RunRenderer::Layout::SideBySide);
     if (!renderer->ok()) {
       std::fprintf(stderr, "cape_compare: %s\n", renderer->error().c_str());
@@ -269,7 +331,7 @@ int main(int argc, char** argv) {
   }
 
   const double length = o.seconds > 0.0 ? o.seconds : MotionDesc::forScene(o.scene).duration;
-  const int frames = static_cast<int>(std::lround(length * 60.0));
+  const std::int64_t frames = std::llround(length * 60.0);  // at most 60 kMaxSeconds
   std::vector<SolverResult> results(static_cast<std::size_t>(1 + twinCount));
   results[0].name = "ours (XPBD cape)";
   results[0].settings = settingsJson(settingsForScene(o.scene, o.settings));
@@ -279,9 +341,21 @@ int main(int argc, char** argv) {
     results[2].name = "btDeformable twin";
     results[2].settings = deformableSettingsJson(deformable);
   }
+  for (SolverResult& r : results) {
+    const char* perFrameName = &r == &results[0]   ? "frames_ours"
+                               : &r == &results[1] ? "frames_btsoftbody"
+                                                   : "frames_deformable";
+    r.perFrame.open(dir / (std::string(perFrameName) + ".csv"));
+    r.perFrame << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_"
+                  "intersections,pin_error_m,blow_up\n";
+    if (!r.perFrame) {
+      std::fprintf(stderr, "cape_compare: cannot write into %s\n", dir.c_str());
+      return 1;
+    }
+  }
   std::vector<SelfIntersectionCounter> counters(static_cast<std::size_t>(ours->characterCount()));
-  Progress progress("cape_compare " + scene, frames);
-  for (int f = 1; f <= frames; ++f) {
+  Progress progress("cape_compare " + scene, static_cast<long>(frames));
+  for (std::int64_t f = 1; f <= frames; ++f) {
     const double t = f / 60.0;
     // Interleaved, so that the machine's noise falls on every solver alike.
     ours->advanceFrame();
@@ -292,8 +366,7 @@ int main(int argc, char** argv) {
                                           &counters[static_cast<std::size_t>(k)]);
       a.metrics = k == 0 ? m : worstOf(a.metrics, m);
     }
-    results[0].rows.push_back(a);
-    results[0].recorder.add(a.metrics);
+    results[0].add(a);
     for (int i = 0; i < twinCount; ++i) {
       const double twinFrame = twinRuns[i].stepFrame(t);
       const double bareFrame = bare[i]->stepFrame(t);
@@ -302,16 +375,14 @@ int main(int argc, char** argv) {
         const FrameMetrics m = twinRuns[i].measure(k);
         b.metrics = k == 0 ? m : worstOf(b.metrics, m);
       }
-      SolverResult& r = results[static_cast<std::size_t>(1 + i)];
-      r.rows.push_back(b);
-      r.recorder.add(b.metrics);
+      results[static_cast<std::size_t>(1 + i)].add(b);
     }
     if (renderer) {
       renderer->record(0, ours->cape(0), ours->bodyColliders(0));
       twinMesh.update(twinRun.fabric(), twinRun.positions(0));
       renderer->record(1, twinMesh, twinRun.bodyColliders(0));
     }
-    progress.update(f);
+    progress.update(static_cast<long>(f));
   }
   progress.finish();
 
@@ -321,7 +392,7 @@ int main(int argc, char** argv) {
   compare["body"] = ours->describe();
   compare["grid"] = {{"columns", size}, {"rows", size}, {"particles", size * size}};
   compare["frames"] = frames;
-  const json ourSummary = summaryFigures(results[0].rows, results[0].recorder.summary());
+  const json ourSummary = summaryFigures(results[0].timings, results[0].recorder.summary());
   const double ourCape = ourSummary["cape_time_us_median"].get<double>();
   std::ofstream csv(dir / "compare.csv");
   csv << "solver,frame_time_us_median,cape_time_us_median,cape_time_us_p95,cape_time_ratio_to_ours,max_"
@@ -329,13 +400,14 @@ int main(int argc, char** argv) {
          "mean_strain,p95_frame_max_strain,max_penetration_m,frames_penetration_over_1mm,self_intersections_"
          "max,"
          "pin_error_max_m,blow_up\n";
-  std::printf("cape_compare: scene %s, %d x %d cape, %d frames -> %s\n%s\n", scene.c_str(), size, size,
-              frames, dir.c_str(), ours->describe().c_str());
+  std::printf("cape_compare: scene %s, %d x %d cape, %" PRId64 " frames -> %s\n%s\n", scene.c_str(), size,
+              size, frames, dir.c_str(), ours->describe().c_str());
   std::printf("%-18s %9s %9s %9s %7s %8s %8s %9s %6s %6s %9s %6s\n", "solver", "frame us", "cape us",
               "cape p95", "x ours", "strain", "mean", "pen m", ">1mm", "self", "pin m", "blowup");
   for (SolverResult& r : results) {
     const RunSummary q = r.recorder.summary();
-    json s = summaryFigures(r.rows, q);
+    r.perFrame.close();
+    json s = summaryFigures(r.timings, q);
     const double ratio = ourCape > 0.0 ? s["cape_time_us_median"].get<double>() / ourCape : 0.0;
     json row = {{"name", r.name},
                 {"frame_time_us_median", s["frame_time_us_median"]},
@@ -353,31 +425,17 @@ int main(int argc, char** argv) {
                 {"settings", r.settings}};
     compare["solvers"].push_back(row);
     char line[512];
-    std::snprintf(line, sizeof line, "%s,%.2f,%.2f,%.2f,%.3f,%.6f,%.6f,%.6f,%.6f,%d,%d,%.3g,%d\n",
+    std::snprintf(line, sizeof line, "%s,%.2f,%.2f,%.2f,%.3f,%.6f,%.6f,%.6f,%.6f,%" PRId64 ",%d,%.3g,%d\n",
                   r.name.c_str(), s["frame_time_us_median"].get<double>(),
                   s["cape_time_us_median"].get<double>(), s["cape_time_us_p95"].get<double>(), ratio,
                   q.maxStrain, q.meanStrain, q.p95FrameMaxStrain, q.maxPenetration,
                   q.framesPenetrationOver1mm, q.selfIntersectionsMax, q.pinErrorMax, q.blowUp ? 1 : 0);
     csv << line;
-    std::printf("%-18s %9.1f %9.1f %9.1f %7.2f %7.2f%% %7.3f%% %9.4f %6d %6d %9.2g %6s\n", r.name.c_str(),
-                s["frame_time_us_median"].get<double>(), s["cape_time_us_median"].get<double>(),
-                s["cape_time_us_p95"].get<double>(), ratio, 100.0 * q.maxStrain, 100.0 * q.meanStrain,
-                q.maxPenetration, q.framesPenetrationOver1mm, q.selfIntersectionsMax, q.pinErrorMax,
-                q.blowUp ? "YES" : "no");
-    // Per-frame rows of each solver.
-    const char* perFrameName = &r == &results[0]   ? "frames_ours"
-                               : &r == &results[1] ? "frames_btsoftbody"
-                                                   : "frames_deformable";
-    std::ofstream perFrame(dir / (std::string(perFrameName) + ".csv"));
-    perFrame << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_"
-                "intersections,pin_error_m,blow_up\n";
-    for (const FrameRow& fr : r.rows) {
-      std::snprintf(line, sizeof line, "%d,%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%d\n", fr.frame, fr.time,
-                    fr.frameTimeUs, fr.capeTimeUs, fr.metrics.maxStrain, fr.metrics.meanStrain,
-                    fr.metrics.maxPenetration, fr.metrics.selfIntersections, fr.metrics.pinError,
-                    fr.metrics.blowUp ? 1 : 0);
-      perFrame << line;
-    }
+    std::printf("%-18s %9.1f %9.1f %9.1f %7.2f %7.2f%% %7.3f%% %9.4f %6" PRId64 " %6d %9.2g %6s\n",
+                r.name.c_str(), s["frame_time_us_median"].get<double>(),
+                s["cape_time_us_median"].get<double>(), s["cape_time_us_p95"].get<double>(), ratio,
+                100.0 * q.maxStrain, 100.0 * q.meanStrain, q.maxPenetration, q.framesPenetrationOver1mm,
+                q.selfIntersectionsMax, q.pinErrorMax, q.blowUp ? "YES" : "no");
   }
   std::printf("settings:\n  ours:         %s\n  btSoftBody:   %s\n", results[0].settings.dump().c_str(),
               results[1].settings.dump().c_str());
@@ -392,27 +450,18 @@ int main(int argc, char** argv) {
   }
 
   if (!noPlots) {
-    auto series = [&](auto value) {
+    auto series = [&](int which) {
       std::vector<Series> out;
-      for (const SolverResult& r : results) {
-        Series s{r.name, {}, {}};
-        for (const FrameRow& fr : r.rows) {
-          s.x.push_back(fr.time);
-          s.y.push_back(value(fr));
-        }
-        out.push_back(std::move(s));
-      }
+      for (const SolverResult& r : results) out.push_back(r.plot.series(r.name, which));
       return out;
     };
     const bool drawn =
         plotLines(dir / "strain.png", "Max structural strain per frame (" + scene + ")", "time, s",
-                  "strain, %", series([](const FrameRow& r) { return 100.0 * r.metrics.maxStrain; }),
-                  error) &&
+                  "strain, %", series(0), error) &&
         plotLines(dir / "penetration.png", "Deepest particle inside a body collider (" + scene + ")",
-                  "time, s", "penetration, mm",
-                  series([](const FrameRow& r) { return 1000.0 * r.metrics.maxPenetration; }), error) &&
+                  "time, s", "penetration, mm", series(1), error) &&
         plotLines(dir / "frame_time.png", "Wall time of stepSimulation per frame (" + scene + ")", "time, s",
-                  "frame time, us", series([](const FrameRow& r) { return r.frameTimeUs; }), error);
+                  "frame time, us", series(2), error);
     if (!drawn) std::fprintf(stderr, "cape_compare: plots not drawn: %s\n", error.c_str());
   }
   return 0;

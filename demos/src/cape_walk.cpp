@@ -1,6 +1,7 @@
 // cape_walk: the headless walking demo. A character walks (or stands, sprints and turns, stands in the wind,
 // or walks in a crowd), its cape follows, and every metric of docs/SCENES.md is written per frame.
 // `cape_walk --help` lists the options; with none it runs the walk scene into a fresh folder it names.
+#include "CliNumbers.h"
 #include "GltfExport.h"
 #include "Progress.h"
 #include "Renderer.h"
@@ -48,28 +49,45 @@ struct YUpView {
 int main(int argc, char** argv) {
   CLI::App app{
       "cape_walk: a character walks headlessly with a cape; writes metrics.csv, summary.json, "
-      "frames/NNNNN.obj and colliders.jsonl to an output folder."};
+      "frames/NNNNN.obj and colliders.jsonl to an output folder. Every number is read whole and checked "
+      "against its range before the run starts."};
+  app.footer(
+      "Exit status: 0 when the run is done; 2 when the cape blew up; 1 when the URDF, the settings or the "
+      "output cannot be used; CLI11's codes (from 100; 105 for a number out of range or not a number) for a "
+      "bad command line.");
   SceneCli sceneCli;
   std::string solver = "xpbd", out;
   int threads = 1, substeps = -1;
+  std::int64_t framesEvery = 1;
   bool noFrames = false, selfCollision = false;
   addSceneOptions(app, sceneCli);
   app.add_option("--solver", solver, "xpbd (default) | explicit (the seed's explicit springs)")
       ->check(CLI::IsMember({"xpbd", "explicit"}))
       ->capture_default_str();
   app.add_option("--substeps", substeps, "solver substeps per 1/60 s frame (default: the solver's)")
-      ->check(CLI::Range(1, 64));
+      ->transform(strictInteger(1, 64));
   app.add_flag("--self-collision", selfCollision, "keep the cape from passing through itself");
   app.add_option("--threads", threads, "worker threads stepping the capes")
-      ->check(CLI::Range(1, 256))
+      ->transform(strictInteger(1, 256))
       ->capture_default_str();
-  app.add_option("--out", out, "output folder (default: a fresh cape_run_<scene>_<time> folder)");
+  app.add_option("--out", out,
+                 "output folder (default: a fresh cape_run_<scene>_<time> folder). A folder that holds a "
+                 "previous cape_walk run (only metrics.csv, summary.json, colliders.jsonl and "
+                 "frames/[kK/]NNNNN.obj) is emptied of it first; a folder with any other file is refused "
+                 "and left as it is");
   app.add_flag("--no-frames", noFrames, "do not write frames/*.obj");
+  app.add_option("--frames-every", framesEvery,
+                 "write frames/NNNNN.obj and the colliders.jsonl line of every N-th frame only (frames N, "
+                 "2N, ...); metrics.csv keeps every frame")
+      ->transform(strictInteger(1, kMaxFrames))
+      ->capture_default_str();
   std::string gltf, render, renderSize = "640x360";
   app.add_option("--gltf", gltf, "also write the run as an animated glTF 2.0 binary (.glb)");
   app.add_option("--render", render,
                  "also render PNG frames (and run.mp4, run.gif with ffmpeg) into this folder");
-  app.add_option("--render-size", renderSize, "rendered image size, WxH")->capture_default_str();
+  app.add_option("--render-size", renderSize, "rendered image size, WxH")
+      ->check(strictImageSize(kMinImageSide, kMaxImageSide, true))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   RunOptions o;
@@ -100,16 +118,23 @@ int main(int argc, char** argv) {
   }
 
   std::string error;
+  const std::filesystem::path dir = out.empty() ? freshRunFolder(scene) : std::filesystem::path(out);
+  if (!checkOutFolder(dir, RunFolderKind::Walk, error)) {
+    std::fprintf(stderr, "cape_walk: %s\n", error.c_str());
+    return 1;
+  }
+  int renderWidth = 0, renderHeight = 0;
+  parseImageSize(renderSize, kMinImageSide, kMaxImageSide, true, renderWidth, renderHeight);  // checked
   std::unique_ptr<SceneRun> run = makeSceneRun(o, error);
   if (!run) {
     std::fprintf(stderr, "cape_walk: %s\n", error.c_str());
     return 1;
   }
   const double length = o.seconds > 0.0 ? o.seconds : MotionDesc::forScene(o.scene).duration;
-  const int frames = static_cast<int>(std::lround(length * 60.0));
-  const std::filesystem::path dir = out.empty() ? freshRunFolder(scene) : std::filesystem::path(out);
+  const std::int64_t frames = std::llround(length * 60.0);  // at most 60 kMaxSeconds
   std::unique_ptr<RunWriter> writer;
   try {
+    if (!prepareOutFolder(dir, RunFolderKind::Walk, error)) throw std::runtime_error(error);
     writer = std::make_unique<RunWriter>(dir, !noFrames, run->characterCount());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cape_walk: %s\n", e.what());
@@ -117,17 +142,12 @@ int main(int argc, char** argv) {
   }
   std::unique_ptr<GltfRecorder> gltfRecorder;
   std::unique_ptr<RunRenderer> renderer;
-  int renderWidth = 0, renderHeight = 0;
   if (!gltf.empty() && !std::ofstream(gltf, std::ios::binary)) {
     std::fprintf(stderr, "cape_walk: cannot write %s\n", gltf.c_str());
     return 1;
   }
   if (!gltf.empty()) gltfRecorder = std::make_unique<GltfRecorder>(run->characterCount());
   if (!render.empty()) {
-    if (std::sscanf(renderSize.c_str(), "%dx%d", &renderWidth, &renderHeight) != 2) {
-      std::fprintf(stderr, "cape_walk: --render-size %s is not WxH\n", renderSize.c_str());
-      return 1;
-    }
     renderer = std::make_unique<RunRenderer>(render, run->characterCount(), renderWidth, renderHeight);
     if (!renderer->ok()) {
       std::fprintf(stderr, "cape_walk: %s\n", renderer->error().c_str());
@@ -137,18 +157,21 @@ int main(int argc, char** argv) {
 
   std::vector<YUpView> views(static_cast<std::size_t>(run->characterCount()));
   const Eigen::Matrix3f toScene = character::Skeleton::sceneToWorld(o.up).transpose().cast<float>();
+  // The summary, streamed: per character, the worst character's (the table's) and the timings.
   std::vector<MetricsRecorder> recorders(static_cast<std::size_t>(run->characterCount()));
   std::vector<SelfIntersectionCounter> counters(recorders.size());
-  std::vector<FrameRow> rows;
-  rows.reserve(static_cast<std::size_t>(frames));
-  Progress progress("cape_walk " + scene, frames);
+  MetricsRecorder worst;
+  FrameTimings timings;
+  std::int64_t framesRun = 0;
+  Progress progress("cape_walk " + scene, static_cast<long>(frames));
   bool blowUp = false;
   // The lowest particle above the ground over the run (m; the ground is the plane through the origin normal
   // to the world's up): a cape that hangs on the back stays well above it.
   double lowest = std::numeric_limits<double>::infinity();
   const Vec3 up = run->up();
-  for (int f = 1; f <= frames && !blowUp; ++f) {
+  for (std::int64_t f = 1; f <= frames && !blowUp; ++f) {
     run->advanceFrame();
+    const bool kept = f % framesEvery == 0;  // frames/*.obj and colliders.jsonl
     FrameRow row;
     row.frame = f;
     row.time = f / 60.0;
@@ -163,7 +186,7 @@ int main(int argc, char** argv) {
       if (run->cape(k).state().positions.rows() > 0)
         lowest = std::min(lowest, static_cast<double>((run->cape(k).state().positions * up).minCoeff()));
       row.metrics = k == 0 ? m : worstOf(row.metrics, m);  // a crowd's row holds the worst of its characters
-      writer->capeMesh(f, k, run->cape(k));
+      if (kept) writer->capeMesh(f, k, run->cape(k));
       if (o.up == character::UpAxis::Y) {
         if (gltfRecorder) gltfRecorder->record(k, run->cape(k), colliders);
         if (renderer) renderer->record(k, run->cape(k), colliders);
@@ -174,16 +197,19 @@ int main(int argc, char** argv) {
         if (gltfRecorder) gltfRecorder->record(k, run->cape(k).fabric(), v.positions, v.colliders);
         if (renderer) renderer->record(k, v.mesh, v.colliders);
       }
+      if (!kept) continue;
       for (Collider c : colliders) {
         if (run->characterCount() > 1) c.name = "k" + std::to_string(k) + "/" + c.name;
         allColliders.push_back(std::move(c));
       }
     }
     writer->frame(row);
-    writer->colliders(f, allColliders);
-    rows.push_back(row);
+    if (kept) writer->colliders(f, allColliders);
+    worst.add(row.metrics);
+    timings.add(row);
+    framesRun = f;
     blowUp = row.metrics.blowUp;
-    progress.update(f);
+    progress.update(static_cast<long>(f));
   }
   progress.finish();
   if (gltfRecorder && !gltfRecorder->write(gltf, error)) {
@@ -201,8 +227,6 @@ int main(int argc, char** argv) {
   }
 
   // Summary: per character and, for the table, the worst character.
-  MetricsRecorder worst;
-  for (const FrameRow& r : rows) worst.add(r.metrics);
   const RunSummary q = worst.summary();
   nlohmann::json summary;
   summary["scene"] = scene;
@@ -220,7 +244,7 @@ int main(int argc, char** argv) {
   summary["frame_time_s"] = 1.0 / 60.0;
   summary["seconds"] = length;
   summary["settings"] = settingsJson(settingsForScene(o.scene, o.settings));
-  summary["summary"] = summaryFigures(rows, q);
+  summary["summary"] = summaryFigures(timings, q);
   summary["summary"]["lowest_particle_m"] = std::isfinite(lowest) ? lowest : 0.0;
   summary["up"] = o.up == character::UpAxis::Z ? "z" : "y";
   // Each cape's final state (stateHash: the bits of its positions and velocities), for determinism checks.
@@ -230,19 +254,14 @@ int main(int argc, char** argv) {
     summary["state_hashes"].push_back(hex);
   }
   if (run->characterCount() > 1) {
-    for (std::size_t k = 0; k < recorders.size(); ++k) {
-      std::vector<FrameRow> own;
-      for (std::size_t f = 0; f < rows.size(); ++f)
-        own.push_back(
-            {rows[f].frame, rows[f].time, rows[f].frameTimeUs, rows[f].capeTimeUs, recorders[k].frames()[f]});
-      summary["per_character"].push_back(summaryFigures(own, recorders[k].summary()));
-    }
+    for (const MetricsRecorder& r : recorders)
+      summary["per_character"].push_back(summaryFigures(timings, r.summary()));
   }
   writer->summary(summary);
 
   const nlohmann::json& s = summary["summary"];
-  std::printf("cape_walk: scene %s, %d x %d cape, %d character(s), %d frames -> %s\n", scene.c_str(), size,
-              size, run->characterCount(), static_cast<int>(rows.size()), dir.c_str());
+  std::printf("cape_walk: scene %s, %d x %d cape, %d character(s), %" PRId64 " frames -> %s\n", scene.c_str(),
+              size, size, run->characterCount(), framesRun, dir.c_str());
   std::printf("  %-34s %10.1f us (p95 %.1f)\n", "frame time, median", s["frame_time_us_median"].get<double>(),
               s["frame_time_us_p95"].get<double>());
   std::printf("  %-34s %10.1f us (p95 %.1f)\n", "cape time, median", s["cape_time_us_median"].get<double>(),
@@ -250,10 +269,10 @@ int main(int argc, char** argv) {
   std::printf("  %-34s %10.2f %%  (median frame %.2f %%, p95 frame %.2f %%)\n", "strain, max",
               100.0 * q.maxStrain, 100.0 * q.medianFrameMaxStrain, 100.0 * q.p95FrameMaxStrain);
   std::printf("  %-34s %10.3f %%\n", "strain, mean", 100.0 * q.meanStrain);
-  std::printf("  %-34s %10.4f m  (%d frames over 1 mm)\n", "penetration, max", q.maxPenetration,
+  std::printf("  %-34s %10.4f m  (%" PRId64 " frames over 1 mm)\n", "penetration, max", q.maxPenetration,
               q.framesPenetrationOver1mm);
-  std::printf("  %-34s %10d    (%d frames with any)\n", "self-intersections, max", q.selfIntersectionsMax,
-              q.framesWithSelfIntersections);
+  std::printf("  %-34s %10d    (%" PRId64 " frames with any)\n", "self-intersections, max",
+              q.selfIntersectionsMax, q.framesWithSelfIntersections);
   std::printf("  %-34s %10.2g m\n", "pin error, max", q.pinErrorMax);
   std::printf("  %-34s %10.3f m\n", "lowest particle above the ground", std::isfinite(lowest) ? lowest : 0.0);
   if (o.scene == SceneKind::Hang)
@@ -261,8 +280,9 @@ int main(int argc, char** argv) {
   std::printf("  %-34s %10s\n", "blow-up", q.blowUp ? "YES" : "no");
   if (blowUp) {
     std::fprintf(stderr,
-                 "cape_walk: the cape blew up at frame %d (NaN or a particle > 10 m from the torso)\n",
-                 static_cast<int>(rows.size()));
+                 "cape_walk: the cape blew up at frame %" PRId64
+                 " (NaN or a particle > 10 m from the torso)\n",
+                 framesRun);
     return 2;
   }
   return 0;

@@ -226,38 +226,100 @@ double percentile(std::vector<double> v, double p) {
   return v[k];
 }
 
-void MetricsRecorder::add(const FrameMetrics& m) {
-  frames_.push_back(m);
+namespace {
+// The histogram's buckets per sign: magnitudes kSmallest g^k, k = 0..kTop, reach kLargest.
+const double kGrowth =
+    (1.0 + PercentileEstimator::kRelativeError) / (1.0 - PercentileEstimator::kRelativeError);
+const std::size_t kTop = static_cast<std::size_t>(
+    std::ceil(std::log(PercentileEstimator::kLargest / PercentileEstimator::kSmallest) / std::log(kGrowth)));
+const std::size_t kZero = kTop + 1;  // the bucket of |v| < kSmallest; negative ones below, positive above
+}  // namespace
+
+PercentileEstimator::PercentileEstimator() : buckets_(2 * kTop + 3, 0) {
+  values_.reserve(kExactValues);
+}
+
+std::size_t PercentileEstimator::bucket(double v) const {
+  const double magnitude = std::abs(v);
+  if (magnitude < kSmallest) return kZero;
+  const double k =
+      std::min(std::ceil(std::log(magnitude / kSmallest) / std::log(kGrowth)), static_cast<double>(kTop));
+  const std::size_t index = static_cast<std::size_t>(std::max(k, 0.0));
+  return v > 0.0 ? kZero + 1 + index : kZero - 1 - index;
+}
+
+double PercentileEstimator::bucketValue(std::size_t b) const {
+  if (b == kZero) return 0.0;
+  const std::size_t k = b > kZero ? b - kZero - 1 : kZero - 1 - b;
+  const double magnitude = 2.0 * kSmallest * std::pow(kGrowth, static_cast<double>(k)) / (kGrowth + 1.0);
+  return b > kZero ? magnitude : -magnitude;
+}
+
+void PercentileEstimator::add(double v) {
+  if (std::isnan(v)) return;
+  min_ = count_ == 0 ? v : std::min(min_, v);
+  max_ = count_ == 0 ? v : std::max(max_, v);
+  ++count_;
+  if (count_ <= static_cast<std::int64_t>(kExactValues)) {
+    values_.push_back(v);
+    return;
+  }
+  if (!values_.empty()) {  // the first value past the exact ones: count those kept so far
+    for (double kept : values_) ++buckets_[bucket(kept)];
+    values_.clear();
+    values_.shrink_to_fit();
+  }
+  ++buckets_[bucket(v)];
+}
+
+double PercentileEstimator::percentile(double p) const {
+  if (count_ == 0) return 0.0;
+  if (exact()) return cape::percentile(values_, p);
+  const double n = static_cast<double>(count_);
+  const std::int64_t rank = static_cast<std::int64_t>(std::clamp(std::ceil(p / 100.0 * n), 1.0, n));
+  if (rank == 1) return min_;
+  if (rank == count_) return max_;
+  std::int64_t below = 0;
+  for (std::size_t b = 0; b < buckets_.size(); ++b) {
+    below += static_cast<std::int64_t>(buckets_[b]);
+    if (below >= rank) return std::clamp(bucketValue(b), min_, max_);
+  }
+  return max_;
+}
+
+MetricsRecorder::MetricsRecorder(double frameTime)
+    : lastSpeeds_(static_cast<std::size_t>(std::max(0L, std::lround(1.0 / frameTime)))) {}
+
+void MetricsRecorder::add(const FrameMetrics& f) {
+  RunSummary& r = running_;
+  // Signed: a run whose every spring stayed compressed has a negative max strain.
+  r.maxStrain = r.frames == 0 ? f.maxStrain : std::max(r.maxStrain, f.maxStrain);
+  ++r.frames;
+  r.blowUp = r.blowUp || f.blowUp;
+  meanStrainSum_ += f.meanStrain;
+  frameMaxStrain_.add(f.maxStrain);
+  r.maxPenetration = std::max(r.maxPenetration, f.maxPenetration);
+  if (f.maxPenetration > 1e-3f) ++r.framesPenetrationOver1mm;
+  r.selfIntersectionsMax = std::max(r.selfIntersectionsMax, f.selfIntersections);
+  if (f.selfIntersections > 0) ++r.framesWithSelfIntersections;
+  r.pinErrorMax = std::max(r.pinErrorMax, f.pinError);
+  if (!lastSpeeds_.empty()) {
+    lastSpeeds_[nextSpeed_] = f.meanSpeed;
+    nextSpeed_ = (nextSpeed_ + 1) % lastSpeeds_.size();
+  }
 }
 
 RunSummary MetricsRecorder::summary() const {
-  RunSummary r;
-  r.frames = static_cast<int>(frames_.size());
-  std::vector<double> maxStrains;
-  maxStrains.reserve(frames_.size());
-  double meanSum = 0.0;
-  // Signed: a run whose every spring stayed compressed has a negative max strain.
-  if (!frames_.empty()) r.maxStrain = frames_.front().maxStrain;
-  for (const FrameMetrics& f : frames_) {
-    r.blowUp = r.blowUp || f.blowUp;
-    r.maxStrain = std::max(r.maxStrain, f.maxStrain);
-    meanSum += f.meanStrain;
-    maxStrains.push_back(f.maxStrain);
-    r.maxPenetration = std::max(r.maxPenetration, f.maxPenetration);
-    if (f.maxPenetration > 1e-3f) ++r.framesPenetrationOver1mm;
-    r.selfIntersectionsMax = std::max(r.selfIntersectionsMax, f.selfIntersections);
-    if (f.selfIntersections > 0) ++r.framesWithSelfIntersections;
-    r.pinErrorMax = std::max(r.pinErrorMax, f.pinError);
-  }
-  if (!frames_.empty()) r.meanStrain = meanSum / static_cast<double>(frames_.size());
-  r.medianFrameMaxStrain = static_cast<float>(percentile(maxStrains, 50.0));
-  r.p95FrameMaxStrain = static_cast<float>(percentile(maxStrains, 95.0));
-  const std::size_t last = static_cast<std::size_t>(std::lround(1.0 / frameTime_));
-  const std::size_t from = frames_.size() > last ? frames_.size() - last : 0;
+  RunSummary r = running_;
+  if (r.frames > 0) r.meanStrain = meanStrainSum_ / static_cast<double>(r.frames);
+  r.medianFrameMaxStrain = static_cast<float>(frameMaxStrain_.percentile(50.0));
+  r.p95FrameMaxStrain = static_cast<float>(frameMaxStrain_.percentile(95.0));
+  // The last second's mean speeds, oldest first.
+  const std::size_t kept = std::min(lastSpeeds_.size(), static_cast<std::size_t>(r.frames));
+  const std::size_t oldest = kept < lastSpeeds_.size() ? 0 : nextSpeed_;
   double speed = 0.0;
-  for (std::size_t i = from; i < frames_.size(); ++i) speed += frames_[i].meanSpeed;
-  if (frames_.size() > from)
-    r.restJitter = static_cast<float>(speed / static_cast<double>(frames_.size() - from));
+  for (std::size_t i = 0; i < kept; ++i) speed += lastSpeeds_[(oldest + i) % lastSpeeds_.size()];
+  if (kept > 0) r.restJitter = static_cast<float>(speed / static_cast<double>(kept));
   return r;
 }
 

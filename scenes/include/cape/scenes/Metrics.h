@@ -4,6 +4,7 @@
 
 #include "cape/core/Cape.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace cape {
@@ -77,31 +78,69 @@ FrameMetrics measureFrame(const Cape& cape, ColliderSpan bodyColliders, const Ve
 FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b);
 
 struct RunSummary {
-  int frames = 0;
-  float maxStrain = 0.0f;             ///< max over frames of the per-frame max strain (signed)
-  double meanStrain = 0.0;            ///< mean over frames of the per-frame mean strain
-  float medianFrameMaxStrain = 0.0f;  ///< median over frames of the per-frame max strain
-  float p95FrameMaxStrain = 0.0f;     ///< 95th percentile over frames of the per-frame max strain
+  std::int64_t frames = 0;
+  float maxStrain = 0.0f;   ///< max over frames of the per-frame max strain (signed)
+  double meanStrain = 0.0;  ///< mean over frames of the per-frame mean strain
+  float medianFrameMaxStrain =
+      0.0f;                        ///< median over frames of the per-frame max strain (PercentileEstimator)
+  float p95FrameMaxStrain = 0.0f;  ///< 95th percentile over frames of the per-frame max strain (the same)
   float maxPenetration = 0.0f;
-  int framesPenetrationOver1mm = 0;
+  std::int64_t framesPenetrationOver1mm = 0;
   int selfIntersectionsMax = 0;
-  int framesWithSelfIntersections = 0;
+  std::int64_t framesWithSelfIntersections = 0;
   float pinErrorMax = 0.0f;
   bool blowUp = false;
   float restJitter = 0.0f;  ///< mean particle speed over the last second, m/s
 };
 
-/// Accumulates frames into a summary.
-class MetricsRecorder {
+/// Nearest-rank percentiles of a stream of values in bounded memory (about 110 KB, allocated up front,
+/// however many values come). The first kExactValues values are kept and the percentile is exact (what
+/// `percentile` gives). From then on the values are counted in a fixed histogram of logarithmic buckets, one
+/// set for each sign: a bucket holds the magnitudes in (s g^(k-1), s g^k] with s = kSmallest and g = (1 + a)
+/// / (1 - a), a = kRelativeError, and stands for 2 s g^k / (g + 1). The rank is found exactly among the
+/// counts, so the estimate differs from the exact percentile q by at most a |q| (plus rounding) for kSmallest
+/// <= |q| <= kLargest, by at most kSmallest when |q| < kSmallest (such values count as 0), and always lies
+/// between the smallest and the largest value seen, which are kept exactly (the 0th and 100th percentiles are
+/// exact). NaN values are not counted.
+class PercentileEstimator {
  public:
-  explicit MetricsRecorder(double frameTime = 1.0 / 60.0) : frameTime_(frameTime) {}
-  void add(const FrameMetrics& m);
-  RunSummary summary() const;
-  const std::vector<FrameMetrics>& frames() const { return frames_; }
+  static constexpr std::size_t kExactValues = 4096;
+  static constexpr double kRelativeError = 0.005;
+  static constexpr double kSmallest = 1e-9;
+  static constexpr double kLargest = 1e12;
+
+  PercentileEstimator();
+  void add(double value);
+  /// The p-th percentile (nearest rank), p in [0, 100]; 0 when no value came.
+  double percentile(double p) const;
+  std::int64_t count() const { return count_; }
+  /// True while every value is kept (the percentiles are exact).
+  bool exact() const { return count_ <= static_cast<std::int64_t>(kExactValues); }
 
  private:
-  double frameTime_;
-  std::vector<FrameMetrics> frames_;
+  std::size_t bucket(double value) const;
+  double bucketValue(std::size_t bucket) const;
+
+  std::vector<double> values_;          ///< the first kExactValues values, then empty
+  std::vector<std::uint64_t> buckets_;  ///< negative magnitudes high to low, zero, positive low to high
+  std::int64_t count_ = 0;
+  double min_ = 0.0, max_ = 0.0;
+};
+
+/// Accumulates frames into a summary, in constant memory: running extrema, counts and sums, the per-frame max
+/// strain in a PercentileEstimator, and the mean speeds of the last second.
+class MetricsRecorder {
+ public:
+  explicit MetricsRecorder(double frameTime = 1.0 / 60.0);
+  void add(const FrameMetrics& m);
+  RunSummary summary() const;
+
+ private:
+  RunSummary running_;  ///< the extrema and counts so far
+  double meanStrainSum_ = 0.0;
+  PercentileEstimator frameMaxStrain_;
+  std::vector<float> lastSpeeds_;  ///< ring of the last second's frames' mean speeds
+  std::size_t nextSpeed_ = 0;      ///< where the next one goes (the oldest once the ring is full)
 };
 
 /// Median and p-th percentile (nearest rank) of a list of values; 0 for an empty list.
