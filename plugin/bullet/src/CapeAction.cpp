@@ -77,12 +77,55 @@ struct DiscoveryCallback : btBroadphaseAabbCallback {
   }
 };
 
+Eigen::Vector3d toDouble(const btVector3& v) {
+  return Eigen::Vector3d(double(v.x()), double(v.y()), double(v.z()));
+}
+
+/// The grid point of `spacing` nearest p (zero for spacing 0 or a point that is not finite).
+Eigen::Vector3d nearestGridPoint(const btVector3& p, btScalar spacing) {
+  const Eigen::Vector3d x = toDouble(p);
+  if (!(spacing > 0) || !std::isfinite(double(spacing)) || !x.allFinite()) return Eigen::Vector3d::Zero();
+  const double g = double(spacing);
+  return Eigen::Vector3d(g * std::round(x.x() / g), g * std::round(x.y() / g), g * std::round(x.z() / g));
+}
+
+/// `world` relative to `origin`, the subtraction in double (the identity for origin zero: same bits).
+btTransform relativeTo(const btTransform& world, const Eigen::Vector3d& origin) {
+  if (origin.isZero()) return world;
+  const Eigen::Vector3d p = toDouble(world.getOrigin()) - origin;
+  return btTransform(world.getBasis(), btVector3(btScalar(p.x()), btScalar(p.y()), btScalar(p.z())));
+}
+
+Pose framePlacement(const btTransform& placement, btScalar spacing) {
+  return toPose(relativeTo(placement, nearestGridPoint(placement.getOrigin(), spacing)));
+}
+
 }  // namespace
 
 CapeAction::CapeAction(FabricPtr fabric, const CapeSettings& settings, const btTransform& placement,
                        const CapeActionSettings& actionSettings)
-    : cape_(std::move(fabric), settings, toPose(placement)), settings_(actionSettings) {
+    : cape_(std::move(fabric), settings, framePlacement(placement, actionSettings.frameSpacing)),
+      settings_(actionSettings) {
   warn_ = [](const std::string& message) { std::cerr << "cape::bullet: " << message << '\n'; };
+  cape_.relocate(nearestGridPoint(placement.getOrigin(), settings_.frameSpacing));
+}
+
+btTransform CapeAction::toFrame(const btTransform& world) const {
+  return relativeTo(world, cape_.origin());
+}
+
+Eigen::Vector3d CapeAction::gridPoint(const btVector3& worldPoint) const {
+  return nearestGridPoint(worldPoint, settings_.frameSpacing);
+}
+
+const Points& CapeAction::positions() const {
+  const Points& x = cape_.state().positions;
+  const Eigen::Vector3d& o = cape_.origin();
+  if (o.isZero()) return x;
+  worldPositions_.resize(x.rows(), 3);
+  for (int c = 0; c < 3; ++c)
+    worldPositions_.col(c) = (x.col(c).cast<double>().array() + o[c]).cast<float>().matrix();
+  return worldPositions_;
 }
 
 CapeAction::~CapeAction() = default;
@@ -94,16 +137,19 @@ void CapeAction::warnOnce(const std::string& key, const std::string& message) {
 
 btVector3 CapeAction::position(std::uint32_t particle) const {
   if (particle >= particleCount()) return btVector3(0, 0, 0);
-  return toBt(Vec3(positions().row(particle).transpose()));
+  const Eigen::Vector3d x = cape_.state().positions.row(particle).transpose().cast<double>() + cape_.origin();
+  return btVector3(btScalar(x.x()), btScalar(x.y()), btScalar(x.z()));
 }
 
 btScalar CapeAction::maxPinError() const {
+  // In the cape's frame, where both the particle and the body's pose are precise.
   btScalar worst = 0;
+  const Points& x = cape_.state().positions;
   for (const Attachment& a : attachments_) {
     auto it = trackedIndex_.find(a.body);
-    if (it == trackedIndex_.end()) continue;
+    if (it == trackedIndex_.end() || a.particle >= particleCount()) continue;
     const btVector3 target = tracked_[it->second].stepEnd * a.localPivot;
-    worst = std::max(worst, (position(a.particle) - target).length());
+    worst = std::max(worst, (toBt(Vec3(x.row(a.particle).transpose())) - target).length());
   }
   return worst;
 }
@@ -127,7 +173,8 @@ CapeAction::Tracked& CapeAction::track(const btCollisionObject* object) {
   Tracked t;
   t.object = object;
   const btTransform& w = object->getWorldTransform();
-  t.lastSeen = t.segmentStart = t.segmentEnd = t.stepStart = t.stepEnd = w;
+  t.lastSeen = w;
+  t.segmentStart = t.segmentEnd = t.stepStart = t.stepEnd = toFrame(w);
   t.worldIndex = object->getWorldArrayIndex();  // a hint for dropMissing (checked before it is trusted)
   trackedIndex_[object] = tracked_.size();
   tracked_.push_back(std::move(t));
@@ -165,14 +212,17 @@ bool CapeAction::attach(std::uint32_t particle, const btRigidBody* body, const b
 
 bool CapeAction::attach(std::uint32_t particle, const btRigidBody* body) {
   if (!ok() || body == nullptr || particle >= particleCount()) return false;
-  return attach(particle, body, body->getWorldTransform().invXform(position(particle)));
+  // The pivot from the body's pose and the particle in the cape's frame: precise however far from the
+  // world's origin.
+  const btVector3 here = toBt(Vec3(cape_.state().positions.row(particle).transpose()));
+  return attach(particle, body, track(body).stepEnd.invXform(here));
 }
 
 std::uint32_t CapeAction::attachNearest(const btRigidBody* body, const btVector3& worldPoint) {
   if (!ok() || body == nullptr) return kNoParticle;
-  const Vec3 p = toVec3(worldPoint);
+  const Vec3 p = toVec3(toFrame(btTransform(btMatrix3x3::getIdentity(), worldPoint)).getOrigin());
   Eigen::Index best = 0;
-  (positions().rowwise() - p.transpose()).rowwise().squaredNorm().minCoeff(&best);
+  (cape_.state().positions.rowwise() - p.transpose()).rowwise().squaredNorm().minCoeff(&best);
   const auto particle = static_cast<std::uint32_t>(best);
   return attach(particle, body, body->getWorldTransform().invXform(worldPoint)) ? particle : kNoParticle;
 }
@@ -274,13 +324,17 @@ void CapeAction::dropMissing(btCollisionWorld* world) {
 void CapeAction::discover(btCollisionWorld* world) {
   for (Tracked& t : tracked_) t.discovered = false;
   if (!settings_.discoverColliders) return;
-  // The cape's bounds at the start of the step, grown by its thickness and the discovery margin.
-  const Points& x = positions();
+  // The cape's bounds at the start of the step, grown by its thickness and the discovery margin, in the
+  // world (the frame's origin added in double).
+  const Points& x = cape_.state().positions;
   const btScalar grow = btScalar(cape_.settings().collisionThickness) + settings_.discoveryMargin;
+  const Eigen::Vector3d& o = cape_.origin();
+  const Eigen::Vector3d lo = x.colwise().minCoeff().transpose().cast<double>() + o;
+  const Eigen::Vector3d hi = x.colwise().maxCoeff().transpose().cast<double>() + o;
   DiscoveryCallback query;
   query.objects = &world->getCollisionObjectArray();
-  query.lo = toBt(Vec3(x.colwise().minCoeff().transpose())) - btVector3(grow, grow, grow);
-  query.hi = toBt(Vec3(x.colwise().maxCoeff().transpose())) + btVector3(grow, grow, grow);
+  query.lo = btVector3(btScalar(lo.x()), btScalar(lo.y()), btScalar(lo.z())) - btVector3(grow, grow, grow);
+  query.hi = btVector3(btScalar(hi.x()), btScalar(hi.y()), btScalar(hi.z())) + btVector3(grow, grow, grow);
   query.group = settings_.collisionGroup;
   query.mask = settings_.collisionMask;
   found_.clear();
@@ -309,7 +363,7 @@ void CapeAction::advancePoses(btScalar dt) {
       // Bullet derived for it (a dynamic body moves by v dt each step, so this gives one step); a body moved
       // without velocity jumps at once.
       t.segmentStart = t.stepEnd;
-      t.segmentEnd = w;
+      t.segmentEnd = toFrame(w);
       t.lastSeen = w;
       t.segmentElapsed = 0;
       t.segmentDuration = 0;
@@ -339,18 +393,72 @@ void CapeAction::advancePoses(btScalar dt) {
   }
 }
 
+void CapeAction::moveFrame(const Eigen::Vector3d& origin, bool carry) {
+  const Eigen::Vector3d shift = cape_.origin() - origin;
+  if (carry)
+    cape_.relocate(origin);
+  else
+    cape_.setOrigin(origin);
+  // Every followed pose in the new frame: where the body is now exactly (from Bullet's world pose), the
+  // poses it is swept from shifted in double.
+  const auto shifted = [&](btTransform& t) { t = relativeTo(t, -shift); };
+  for (Tracked& t : tracked_) {
+    shifted(t.segmentStart);
+    shifted(t.stepStart);
+    shifted(t.stepEnd);
+    t.segmentEnd = toFrame(t.lastSeen);
+    if (t.jumped) t.stepStart = t.stepEnd = t.segmentEnd;
+  }
+}
+
 void CapeAction::applyTeleport() {
   teleported_ = false;
   const btRigidBody* ref = referenceBody();
   Tracked* t = ref != nullptr ? find(ref) : nullptr;
-  if (t == nullptr) return;
-  if (t->jumped) {
-    // The character jumped: carry the cape rigidly (positions, velocities, pin targets), no stretching.
-    // The jump is measured from where the action had the body to where it is now.
-    const btTransform delta = t->segmentEnd * t->segmentStart.inverse();
-    cape_.teleport(toPose(delta));
-    teleported_ = true;
-  }
+  if (t == nullptr || !t->jumped) return;
+  // The character jumped: carry the cape rigidly (positions, velocities, pin targets), no stretching. The
+  // jump is measured from where the action had the body (in the cape's frame) to where it is now (in the
+  // world, in double): x -> R (x - c0) + c1. The frame goes with it to the grid point nearest c1, so the
+  // cape's coordinates stay small however far the jump (a body moved by 1e20 m and back brings its cape
+  // back intact).
+  const btQuaternion q0 = t->segmentStart.getRotation(), q1 = t->lastSeen.getRotation();
+  const btQuaternion dq = q1 * q0.inverse();
+  const Quat r(float(dq.w()), float(dq.x()), float(dq.y()), float(dq.z()));
+  const Eigen::Vector3d c0 = toDouble(t->segmentStart.getOrigin());
+  const Eigen::Vector3d c1 = toDouble(t->lastSeen.getOrigin()) - cape_.origin();  // old frame
+  const Eigen::Vector3d origin = gridPoint(t->lastSeen.getOrigin());
+  const Eigen::Vector3d shift = cape_.origin() - origin;  // old frame to new
+  Pose delta;
+  delta.rotation = r.normalized();
+  const Eigen::Vector3d turned = delta.rotation.cast<double>() * c0;
+  delta.position = (c1 - turned + shift).cast<float>();
+  if (!delta.isFinite() || !origin.allFinite()) return;
+  cape_.teleport(delta);
+  moveFrame(origin, true);
+  teleported_ = true;
+}
+
+void CapeAction::followReference() {
+  // The frame follows the reference body once it is more than a spacing away.
+  const btRigidBody* ref = referenceBody();
+  const Tracked* t = ref != nullptr ? find(ref) : nullptr;
+  if (t == nullptr || t->jumped || !(settings_.frameSpacing > 0)) return;
+  const btVector3 c = t->stepEnd.getOrigin();
+  const bool away = std::abs(c.x()) > settings_.frameSpacing || std::abs(c.y()) > settings_.frameSpacing ||
+                    std::abs(c.z()) > settings_.frameSpacing;
+  if (!away) return;
+  const Eigen::Vector3d origin = gridPoint(t->lastSeen.getOrigin());
+  if (origin.allFinite() && origin != cape_.origin()) moveFrame(origin, false);
+}
+
+void CapeAction::reportGuard() {
+  // The guard runs in advance() (perhaps on a worker thread of CapeGroup): its warning is said here.
+  const Cape::GuardReport& g = cape_.guard();
+  if (g.total == guardReported_) return;
+  guardReported_ = g.total;
+  warnOnce("guard", "the cape's numerical guard restored " + std::to_string(g.total) +
+                        " particle(s) (not finite, or runaway) by step " + std::to_string(stepCount_) +
+                        "; Cape::guard() counts them (said once)");
 }
 
 void CapeAction::applyInertia() {
@@ -450,7 +558,7 @@ void CapeAction::gatherTriangles(const btConcaveShape* shape, const btTransform&
   } collect;
   collect.soup = &soup;
   soup.corners.clear();  // keeps its capacity: no allocation once the cape has met the mesh
-  const Points& x = positions();
+  const Points& x = cape_.state().positions;  // the poses are in the cape's frame too
   const btScalar grow =
       btScalar(cape_.settings().collisionThickness) + shape->getMargin() + settings_.discoveryMargin;
   const btVector3 lo = toBt(Vec3(x.colwise().minCoeff().transpose())) - btVector3(grow, grow, grow);
@@ -480,10 +588,12 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   if (!ok() || world == nullptr || !(dt > 0)) return;
   const auto start = std::chrono::steady_clock::now();
   if (settings_.useWorldGravity) followGravity(world);
+  reportGuard();
   dropMissing(world);
   discover(world);
   advancePoses(dt);
   applyTeleport();
+  followReference();
   updatePins();
   applyInertia();  // after the pins have their new targets: it shifts where they start
   buildColliders();

@@ -76,6 +76,16 @@ struct CapeActionSettings {
   /// so a Z-up world or a changed gravity needs nothing more. Off: CapeSettings::gravity stays in force. A
   /// world whose gravity is not finite leaves the cape's gravity as it was, with one warning.
   bool useWorldGravity = true;
+
+  /// The cape simulates in a frame of its own (Cape::origin, local space as NvCloth's), so a character far
+  /// from the world's origin gets the precision it has at the origin: its particles, pins and colliders are
+  /// float coordinates relative to a point on a grid of this spacing (m), taken in double from Bullet's
+  /// poses. The point is the grid point nearest the placement, and then, whenever the reference body is more
+  /// than one spacing (along an axis) from it, the grid point nearest the body. A cape within half a spacing
+  /// of the world's origin keeps the world's frame (origin zero) until it travels a spacing away; a teleport
+  /// moves the frame with the cape exactly, however far. 0: always the world's frame (a float world
+  /// position far from the origin then loses the precision Bullet's float loses there).
+  btScalar frameSpacing = btScalar(16);
 };
 
 /// One particle pinned to a rigid body at a point in the body's frame.
@@ -133,7 +143,8 @@ class CapeAction : public btActionInterface {
   void addCollider(const btCollisionObject* object);
   /// Stop colliding with an object added by addCollider (discovery may still find it).
   void removeCollider(const btCollisionObject* object);
-  /// The core colliders of the last step (poses at its start and end), for drawing, metrics and tests.
+  /// The core colliders of the last step (poses at its start and end, in the cape's frame: world less
+  /// frameOrigin()), for drawing, metrics and tests.
   const std::vector<Collider>& coreColliders() const { return colliders_; }
   /// The collision objects whose shapes were used in the last step (in a deterministic order).
   const std::vector<const btCollisionObject*>& activeObjects() const { return activeObjects_; }
@@ -156,8 +167,12 @@ class CapeAction : public btActionInterface {
 
   // --- Results -----------------------------------------------------------------------------------------
   std::size_t particleCount() const { return cape_.ok() ? cape_.fabric().particleCount() : 0; }
-  /// Particle positions, m, world (one row per particle, columns x, y, z).
-  const Points& positions() const { return cape_.state().positions; }
+  /// Particle positions, m, world (one row per particle, columns x, y, z), as floats. The solver's own are
+  /// cape().state().positions, relative to cape().origin(); with a frame away from the world's origin this
+  /// converts them into a buffer of the action's (valid until the next call; not for concurrent callers).
+  const Points& positions() const;
+  /// The world position of the cape's frame (Cape::origin), m.
+  const Eigen::Vector3d& frameOrigin() const { return cape_.origin(); }
   btVector3 position(std::uint32_t particle) const;
   /// Wall time of the cape's own work in the last internal step (prepare() and advance()), microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
@@ -176,7 +191,7 @@ class CapeAction : public btActionInterface {
   /// A collision object the action follows: an attachment body, a collider, or both.
   struct Tracked {
     const btCollisionObject* object = nullptr;
-    btTransform lastSeen;          ///< Its world transform when last read.
+    btTransform lastSeen;          ///< Its world transform when last read (the rest: in the cape's frame).
     btTransform segmentStart;      ///< The motion being spread over internal steps: from here...
     btTransform segmentEnd;        ///< ...to here,
     btScalar segmentDuration = 0;  ///< over this long, s (from the body's velocity; 0: at once).
@@ -207,6 +222,14 @@ class CapeAction : public btActionInterface {
   void gatherTriangles(const btConcaveShape* shape, const btTransform& start, const btTransform& end,
                        TriangleSoup& soup) const;
   void refreshPinIndices();
+  /// A world pose in the cape's frame (the origin subtracted in double), and the frame's grid point near p.
+  btTransform toFrame(const btTransform& world) const;
+  Eigen::Vector3d gridPoint(const btVector3& worldPoint) const;
+  /// Moves the cape's frame to `origin` (the cape stays put in the world, or jumps with the frame when
+  /// `carry`) and re-expresses every followed pose in it.
+  void moveFrame(const Eigen::Vector3d& origin, bool carry);
+  void followReference();
+  void reportGuard();
   void warnOnce(const std::string& key, const std::string& message);
   const btRigidBody* referenceBody() const;
 
@@ -229,6 +252,8 @@ class CapeAction : public btActionInterface {
   std::size_t meshCount_ = 0;
 
   bool teleported_ = false;
+  mutable Points worldPositions_;  ///< positions() when the frame is away from the world's origin.
+  std::uint64_t guardReported_ = 0;
   std::uint64_t stepCount_ = 0;
   double lastStepMicroseconds_ = 0.0;
   double prepareMicroseconds_ = 0.0;
