@@ -48,38 +48,11 @@ void BM_DiscoveryWalkFrame(benchmark::State& state) {
         },
         other.world.get(), true);
   }
-  std::vector<std::pair<btRigidBody*, btTransform>> parts;
-  const auto part = [&](btCollisionShape* s, const btVector3& at) {
-    const btTransform local(btQuaternion::getIdentity(), at);
-    parts.push_back({w.addKinematic(s, local), local});
-    return parts.back().first;
-  };
-  part(new btBoxShape(btVector3(0.2f, 0.3f, 0.12f)), btVector3(0, 1.25f, 0));
-  btRigidBody* left = part(new btSphereShape(0.08f), btVector3(-0.22f, 1.52f, 0));
-  btRigidBody* right = part(new btSphereShape(0.08f), btVector3(0.22f, 1.52f, 0));
-  part(new btCapsuleShape(0.07f, 0.66f), btVector3(-0.1f, 0.55f, 0));
-  part(new btCapsuleShape(0.07f, 0.66f), btVector3(0.1f, 0.55f, 0));
   w.addStatic(new btStaticPlaneShape(btVector3(0, 1, 0), 0), btTransform::getIdentity());
-
-  const cape::CapeRig rig = cape::makeCapeRig(20, cape::PinLayout::Corners);
-  cape::bullet::CapeAction action(rig.fabric, cape::CapeSettings(),
-                                  cape::bullet::toBt(cape::capeStartPlacement(cape::SceneKind::Walk)));
-  const btRigidBody* shoulders[2] = {left, right};
-  for (int k = 0; k < 2; ++k) {
-    const btVector3 at = cape::bullet::toBt(rig.pinLocalPoints[std::size_t(k)]);
-    action.attach(rig.pinnedParticles[std::size_t(k)], shoulders[k],
-                  shoulders[k]->getWorldTransform().invXform(at));
-  }
-  w.world->addAction(&action);
   // The walk goes on without restarting (a restart would teleport the cape): the boxes stay >= 60 m away.
-  const cape::MotionDesc motion = cape::MotionDesc::forScene(cape::SceneKind::Walk);
-  int frame = 0;
-  const auto advance = [&]() {
-    ++frame;
-    const btTransform f = cape::bullet::toBt(cape::motionAt(motion, frame / 60.0).frame());
-    for (auto& p : parts) World::moveKinematic(p.first, f * p.second);
-    w.world->stepSimulation(kFrame, 8, kFixed);
-  };
+  SimpleWalk walk(w);
+  cape::bullet::CapeAction& action = *walk.action;
+  const auto advance = [&]() { walk.advance(); };
   // Warm up one simulated second so that the cape is in contact with the body, as in the other benchmarks.
   for (int k = 0; k < 60; ++k) advance();
   action.takeAccumulatedMicroseconds();
@@ -101,7 +74,6 @@ void BM_DiscoveryWalkFrame(benchmark::State& state) {
   state.counters["world_objects"] = static_cast<double>(w.world->getNumCollisionObjects());
   state.counters["colliders"] = static_cast<double>(action.activeObjects().size());
   if (!action.positions().allFinite()) state.SkipWithError("the cape blew up");
-  w.world->removeAction(&action);
 }
 
 }  // namespace

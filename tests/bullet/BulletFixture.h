@@ -13,7 +13,10 @@
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 #include <btBulletDynamicsCommon.h>
 
+#include "cape/bullet/Convert.h"
+
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace capetest {
@@ -137,6 +140,57 @@ inline btTransform horizontalAt(btScalar y) {
   btTransform t(btQuaternion(btVector3(1, 0, 0), SIMD_HALF_PI), btVector3(btScalar(-0.3), y, btScalar(0.5)));
   return t;
 }
+
+/// docs/SCENES.md's walk on kinematic Bullet bodies in `world`: a torso box, shoulder spheres and leg
+/// capsules moved rigidly with the character frame, the canonical cape pinned by its corners to the
+/// shoulders, the whole scene moved by `offset`; advance() is one 1/60 s frame, stepSimulation(1/60, 8,
+/// 1/240).
+struct SimpleWalk {
+  SimpleWalk(World& w, const btVector3& offset = btVector3(0, 0, 0),
+             const cape::bullet::CapeActionSettings& settings = cape::bullet::CapeActionSettings())
+      : world(w),
+        shift(btQuaternion::getIdentity(), offset),
+        motion(cape::MotionDesc::forScene(cape::SceneKind::Walk)) {
+    const auto part = [&](btCollisionShape* s, const btVector3& at) {
+      const btTransform local(btQuaternion::getIdentity(), at);
+      parts.push_back({w.addKinematic(s, shift * local), local});
+      return parts.back().first;
+    };
+    part(new btBoxShape(btVector3(0.2f, 0.3f, 0.12f)), btVector3(0, 1.25f, 0));
+    btRigidBody* left = part(new btSphereShape(0.08f), btVector3(-0.22f, 1.52f, 0));
+    btRigidBody* right = part(new btSphereShape(0.08f), btVector3(0.22f, 1.52f, 0));
+    part(new btCapsuleShape(0.07f, 0.66f), btVector3(-0.1f, 0.55f, 0));
+    part(new btCapsuleShape(0.07f, 0.66f), btVector3(0.1f, 0.55f, 0));
+    const cape::CapeRig rig = cape::makeCapeRig(20, cape::PinLayout::Corners);
+    action = std::make_unique<cape::bullet::CapeAction>(
+        rig.fabric, cape::CapeSettings(),
+        shift * cape::bullet::toBt(cape::capeStartPlacement(cape::SceneKind::Walk)), settings);
+    const btRigidBody* shoulders[2] = {left, right};
+    for (int k = 0; k < 2; ++k) {
+      const btVector3 at = shift * cape::bullet::toBt(rig.pinLocalPoints[std::size_t(k)]);
+      action->attach(rig.pinnedParticles[std::size_t(k)], shoulders[k],
+                     shoulders[k]->getWorldTransform().invXform(at));
+    }
+    w.world->addAction(action.get());
+  }
+  ~SimpleWalk() { world.world->removeAction(action.get()); }
+  SimpleWalk(const SimpleWalk&) = delete;
+  SimpleWalk& operator=(const SimpleWalk&) = delete;
+
+  void advance() {
+    ++frame;
+    const btTransform f = shift * cape::bullet::toBt(cape::motionAt(motion, frame / 60.0).frame());
+    for (auto& p : parts) World::moveKinematic(p.first, f * p.second);
+    world.world->stepSimulation(kFrame, 8, kFixed);
+  }
+
+  World& world;
+  btTransform shift;
+  cape::MotionDesc motion;
+  std::vector<std::pair<btRigidBody*, btTransform>> parts;  ///< body, pose in the character frame
+  std::unique_ptr<cape::bullet::CapeAction> action;
+  int frame = 0;
+};
 
 inline bool allFinite(const cape::Points& x) {
   return x.allFinite();

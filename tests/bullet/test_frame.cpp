@@ -35,37 +35,14 @@ struct WalkFigures {
 /// decision taken one step apart, changes the 3 s median by 20 %), 9 s of walking are not.
 WalkFigures walkAt(const btVector3& offset, btScalar frameSpacing) {
   World w;
-  std::vector<std::pair<btRigidBody*, btTransform>> parts;
-  const btTransform shift(btQuaternion::getIdentity(), offset);
-  auto part = [&](btCollisionShape* s, const btVector3& at) {
-    const btTransform local(btQuaternion::getIdentity(), at);
-    parts.push_back({w.addKinematic(s, shift * local), local});
-    return parts.back().first;
-  };
-  part(new btBoxShape(btVector3(0.2f, 0.3f, 0.12f)), btVector3(0, 1.25f, 0));
-  btRigidBody* left = part(new btSphereShape(0.08f), btVector3(-0.22f, 1.52f, 0));
-  btRigidBody* right = part(new btSphereShape(0.08f), btVector3(0.22f, 1.52f, 0));
-  part(new btCapsuleShape(0.07f, 0.66f), btVector3(-0.1f, 0.55f, 0));
-  part(new btCapsuleShape(0.07f, 0.66f), btVector3(0.1f, 0.55f, 0));
-  const cape::CapeRig rig = cape::makeCapeRig(20, cape::PinLayout::Corners);
   CapeActionSettings settings;
   settings.frameSpacing = frameSpacing;
-  CapeAction action(rig.fabric, cape::CapeSettings(),
-                    shift * cape::bullet::toBt(cape::capeStartPlacement(cape::SceneKind::Walk)), settings);
-  const btRigidBody* shoulders[2] = {left, right};
-  for (int k = 0; k < 2; ++k) {
-    const btVector3 at = shift * cape::bullet::toBt(rig.pinLocalPoints[std::size_t(k)]);
-    EXPECT_TRUE(action.attach(rig.pinnedParticles[std::size_t(k)], shoulders[k],
-                              shoulders[k]->getWorldTransform().invXform(at)));
-  }
-  w.world->addAction(&action);
-  const cape::MotionDesc motion = cape::MotionDesc::forScene(cape::SceneKind::Walk);
+  SimpleWalk walk(w, offset, settings);
+  const CapeAction& action = *walk.action;
   WalkFigures out;
   std::vector<float> strains;
   for (int frame = 1; frame <= 600; ++frame) {
-    const btTransform f = shift * cape::bullet::toBt(cape::motionAt(motion, frame / 60.0).frame());
-    for (auto& p : parts) World::moveKinematic(p.first, f * p.second);
-    w.world->stepSimulation(kFrame, 8, kFixed);
+    walk.advance();
     const cape::Points& x = action.cape().state().positions;
     out.finite = out.finite && x.allFinite();
     if (frame > 60) strains.push_back(maxStructuralStrain(action.cape()));  // from the walk's second second
@@ -76,7 +53,6 @@ WalkFigures walkAt(const btVector3& offset, btScalar frameSpacing) {
   std::nth_element(strains.begin(), strains.begin() + strains.size() / 2, strains.end());
   out.medianStrain = strains[strains.size() / 2];
   out.frameOrigin = action.frameOrigin();
-  w.world->removeAction(&action);
   return out;
 }
 

@@ -411,6 +411,10 @@ void CapeAction::moveFrame(const Eigen::Vector3d& origin, bool carry) {
   }
 }
 
+void CapeAction::relocate(const Eigen::Vector3d& origin) {
+  if (ok() && origin.allFinite()) moveFrame(origin, true);
+}
+
 void CapeAction::applyTeleport() {
   teleported_ = false;
   const btRigidBody* ref = referenceBody();

@@ -173,6 +173,10 @@ class CapeAction : public btActionInterface {
   const Points& positions() const;
   /// The world position of the cape's frame (Cape::origin), m.
   const Eigen::Vector3d& frameOrigin() const { return cape_.origin(); }
+  /// Moves the cape rigidly, frame and all, so that the frame's origin is `origin` (a translation by
+  /// origin - frameOrigin(), exact however far): build a cape placed relative to a point far from the world's
+  /// origin, then relocate it there, and it keeps every bit of its shape. Ignored unless finite.
+  void relocate(const Eigen::Vector3d& origin);
   btVector3 position(std::uint32_t particle) const;
   /// Wall time of the cape's own work in the last internal step (prepare() and advance()), microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
