@@ -34,6 +34,7 @@ class BulletCapeRun final : public SceneRun {
         error = cape->cape().status().message();
         return false;
       }
+      cape->relocate(scene_->origin());  // placed relative to the scene's origin: moved there exactly
       for (const PinSpec& p : scene_->pins(k)) cape->attach(p.particle, p.body, p.localPivot);
       group_->add(cape.get());
       capes_.push_back(std::move(cape));
@@ -52,8 +53,15 @@ class BulletCapeRun final : public SceneRun {
     if (group_->threadCount() > 1) capeUs_ = std::min(capeUs_, frameUs_);
   }
   const Cape& cape(int k) const override { return capes_[static_cast<std::size_t>(k)]->cape(); }
-  std::vector<Collider> bodyColliders(int k) const override { return scene_->bodyColliders(k); }
-  Vec3 torsoCentre(int k) const override { return scene_->torsoCentre(k); }
+  std::vector<Collider> bodyColliders(int k) const override {
+    return scene_->bodyColliders(k, capes_[static_cast<std::size_t>(k)]->frameOrigin());
+  }
+  Vec3 torsoCentre(int k) const override {
+    return scene_->torsoCentre(k, capes_[static_cast<std::size_t>(k)]->frameOrigin());
+  }
+  Eigen::Vector3d frameOffset(int k) const override {
+    return capes_[static_cast<std::size_t>(k)]->frameOrigin() - scene_->origin();
+  }
   double lastFrameTimeUs() const override { return frameUs_; }
   double lastCapeTimeUs() const override { return capeUs_; }
   std::string describe() const override { return scene_->describe(); }

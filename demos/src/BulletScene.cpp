@@ -82,6 +82,10 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
     error = "--up z needs a URDF character (the simple body is built in the Y-up frame of docs/SCENES.md)";
     return false;
   }
+  if (o.simpleBody && !o.origin.isZero()) {
+    error = "--origin needs a URDF character (the simple body is built in float world coordinates)";
+    return false;
+  }
   toWorld_ = character::Skeleton::sceneToWorld(o.up).cast<float>();
   makeWorld(kind);
 
@@ -138,7 +142,10 @@ void BulletScene::makeWorld(WorldKind kind) {
   info->m_gravity = world_->getGravity();
   info->air_density = btScalar(1.2);
 
-  groundShape_ = std::make_unique<btStaticPlaneShape>(toBt(toWorld(Vec3::UnitY())), btScalar(0));
+  // Through the scene's origin (--origin), where the characters stand.
+  const Vec3 up = toWorld(Vec3::UnitY());
+  groundShape_ =
+      std::make_unique<btStaticPlaneShape>(toBt(up), btScalar(up.cast<double>().dot(options_.origin)));
   ground_ = std::make_unique<btRigidBody>(btScalar(0), nullptr, groundShape_.get());
   ground_->setUserIndex(-1);
   world_->addRigidBody(ground_.get());
@@ -181,7 +188,7 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
   auto c = std::make_unique<Character>();
   c->offset = offset;
   character::CharacterSettings cs;
-  cs.offset = offset.cast<double>();
+  cs.offset = offset.cast<double>() + options_.origin;
   cs.up = options_.up;
   cs.rootHeight = options_.rootHeight;
   cs.pose = options_.pose;
@@ -242,7 +249,9 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
   // The pin line: 4 cm above the shoulders' centre and 3 cm behind the back (docs/SCENES.md: 15 cm behind
   // the shipped humanoid's shoulders, whose back is 12 cm behind them). In float as it always was, so the
   // shipped humanoid's cape starts where it did to the bit.
-  const Vec3 centre = a.left.cast<float>() / 2.0f + a.right.cast<float>() / 2.0f;
+  // Relative to the scene's origin (subtracted in double: the same bits when it is zero).
+  const Eigen::Vector3d o = toScene * options_.origin;
+  const Vec3 centre = (a.left - o).cast<float>() / 2.0f + (a.right - o).cast<float>() / 2.0f;
   const Vec3 above(0.0f, kPinLineAbove, static_cast<float>(a.back + kPinLineBehindBack));
   c->shift = centre + above - kPinLineCentre;
   if (first) {
@@ -287,8 +296,17 @@ void BulletScene::placeCape(Character& c) {
           return std::fabs(a.first - point.x()) < std::fabs(b.first - point.x());
         });
     btRigidBody* body = nearest->second;
-    c.pins.push_back(
-        {rig_.pinnedParticles[p], body, body->getWorldTransform().inverse() * toBt(toWorld(point))});
+    // The pivot from the body's pose relative to the scene's origin (in double), so it keeps its precision
+    // however far away the scene is; the identity of old at the origin.
+    const btTransform& w = body->getWorldTransform();
+    btTransform relative = w;
+    if (!options_.origin.isZero()) {
+      const Eigen::Vector3d p0 =
+          Eigen::Vector3d(double(w.getOrigin().x()), double(w.getOrigin().y()), double(w.getOrigin().z())) -
+          options_.origin;
+      relative.setOrigin(btVector3(btScalar(p0.x()), btScalar(p0.y()), btScalar(p0.z())));
+    }
+    c.pins.push_back({rig_.pinnedParticles[p], body, relative.inverse() * toBt(toWorld(point))});
   }
 }
 
@@ -314,17 +332,25 @@ double BulletScene::stepFrame(double t) {
   return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
 }
 
-std::vector<Collider> BulletScene::bodyColliders(int k) const {
+std::vector<Collider> BulletScene::bodyColliders(int k, const Eigen::Vector3d& frame) const {
   const Character& c = *characters_[static_cast<std::size_t>(k)];
   if (c.simple) {
     const ColliderSpan s = c.simple->body().bodyColliders();
-    return std::vector<Collider>(s.begin(), s.end());
+    std::vector<Collider> out(s.begin(), s.end());
+    if (!frame.isZero())
+      for (Collider& col : out) {
+        col.previous.position = (col.previous.position.cast<double>() - frame).cast<float>();
+        col.current.position = (col.current.position.cast<double>() - frame).cast<float>();
+      }
+    return out;
   }
   std::vector<Collider> out;
   const std::vector<character::WorldShape> shapes = c.urdf->skeleton().worldShapes();
   for (std::size_t k = 0; k < shapes.size(); ++k) {
     const character::WorldShape& w = shapes[k];
-    const Pose pose = poseOf(w.pose);
+    Eigen::Isometry3d relative = w.pose;
+    relative.translation() -= frame;
+    const Pose pose = poseOf(relative);
     Collider col;
     switch (w.shape->type) {
       case character::ShapeType::Sphere:
@@ -352,10 +378,10 @@ std::vector<Collider> BulletScene::bodyColliders(int k) const {
   return out;
 }
 
-Vec3 BulletScene::torsoCentre(int k) const {
+Vec3 BulletScene::torsoCentre(int k, const Eigen::Vector3d& frame) const {
   const Character& c = *characters_[static_cast<std::size_t>(k)];
-  if (c.simple) return c.simple->body().torsoCentre();
-  return c.urdf->skeleton().linkPose(c.torsoLink).translation().cast<float>();
+  if (c.simple) return (c.simple->body().torsoCentre().cast<double>() - frame).cast<float>();
+  return (c.urdf->skeleton().linkPose(c.torsoLink).translation() - frame).cast<float>();
 }
 
 Pose BulletScene::capePlacement(int k) const {

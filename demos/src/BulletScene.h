@@ -65,11 +65,14 @@ class BulletScene {
   double stepFrame(double t);
 
   /// A character's body colliders at its current pose (true surfaces, ground excluded), for the metrics and
-  /// colliders.jsonl.
-  std::vector<Collider> bodyColliders(int character) const;
-  /// Where the blow-up metric measures from: the torso's centre.
-  Vec3 torsoCentre(int character) const;
-  /// The cape's starting placement in the world (world = placement * fabric rest shape).
+  /// colliders.jsonl, relative to the world point `frame` (a cape's frame; subtracted in double).
+  std::vector<Collider> bodyColliders(int character,
+                                      const Eigen::Vector3d& frame = Eigen::Vector3d::Zero()) const;
+  /// Where the blow-up metric measures from: the torso's centre, relative to `frame`.
+  Vec3 torsoCentre(int character, const Eigen::Vector3d& frame = Eigen::Vector3d::Zero()) const;
+  /// The scene's origin in the world (--origin): the characters start there, on the ground through it.
+  const Eigen::Vector3d& origin() const { return options_.origin; }
+  /// The cape's starting placement relative to origin() (world = origin + placement * fabric rest shape).
   Pose capePlacement(int character) const;
   /// The cape's pins: particles, bodies and body-frame pivots.
   const std::vector<PinSpec>& pins(int character) const;

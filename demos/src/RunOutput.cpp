@@ -150,16 +150,16 @@ void RunWriter::frame(const FrameRow& r) {
   csv_ << line;
 }
 
-void RunWriter::capeMesh(std::int64_t frame, int character, const Cape& cape) {
+void RunWriter::capeMesh(std::int64_t frame, int character, const Fabric& fabric, const Points& positions) {
   if (!writeFrames_) return;
-  if (mesh_.positions.rows() != static_cast<Eigen::Index>(cape.fabric().particleCount()))
-    mesh_.allocate(cape.fabric(), false);
-  mesh_.update(cape.fabric(), cape.state().positions);
+  if (mesh_.positions.rows() != static_cast<Eigen::Index>(fabric.particleCount()))
+    mesh_.allocate(fabric, false);
+  mesh_.update(fabric, positions);
   char name[32];
   std::snprintf(name, sizeof name, "%05" PRId64 ".obj", frame);
   const fs::path folder =
       characters_ > 1 ? dir_ / "frames" / ("k" + std::to_string(character)) : dir_ / "frames";
-  writeObj(folder / name, mesh_, cape.fabric().particleCount());
+  writeObj(folder / name, mesh_, fabric.particleCount());
 }
 
 void RunWriter::colliders(std::int64_t frame, const std::vector<Collider>& colliders) {

@@ -42,7 +42,7 @@ class RunWriter {
   /// Creates the folder (and frames/ unless writeFrames is false). Throws std::runtime_error if it cannot.
   RunWriter(const std::filesystem::path& dir, bool writeFrames, int characters);
   void frame(const FrameRow& row);
-  void capeMesh(std::int64_t frame, int character, const Cape& cape);
+  void capeMesh(std::int64_t frame, int character, const Fabric& fabric, const Points& positions);
   void colliders(std::int64_t frame, const std::vector<Collider>& colliders);
   void summary(const nlohmann::json& summary);
   const std::filesystem::path& dir() const { return dir_; }

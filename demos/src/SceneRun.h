@@ -45,10 +45,16 @@ class SceneRun {
   virtual int characterCount() const = 0;
   /// Advances one frame of 1/60 s.
   virtual void advanceFrame() = 0;
+  /// A character's cape. Its state is in its own frame (Cape::origin): see frameOffset().
   virtual const Cape& cape(int character) const = 0;
-  /// Body colliders of a character at the current frame (ground excluded), for metrics and colliders.jsonl.
+  /// Body colliders of a character at the current frame (ground excluded), in its cape's frame, for the
+  /// metrics (precise there however far the character is) and, moved by frameOffset(), the outputs.
   virtual std::vector<Collider> bodyColliders(int character) const = 0;
+  /// The torso's centre, in the cape's frame.
   virtual Vec3 torsoCentre(int character) const = 0;
+  /// The cape's frame less the scene's origin (--origin), m: what turns the cape's frame coordinates into
+  /// the scene's, in which every output is written (the ground through the scene's origin).
+  virtual Eigen::Vector3d frameOffset(int character) const = 0;
   /// Wall time of the last frame, and the cape solver's share of it, µs.
   virtual double lastFrameTimeUs() const = 0;
   virtual double lastCapeTimeUs() const = 0;

@@ -24,21 +24,27 @@ using namespace cape::demo;
 
 namespace {
 
-// A cape and its colliders turned from a Z-up world into the Y-up scene frame, for glTF and the renderer.
-struct YUpView {
+// A cape and its colliders moved from the cape's frame into the scene's (by SceneRun::frameOffset, in
+// double) and turned by `turn` (the identity, or a Z-up world into the Y-up scene frame for glTF and the
+// renderer), for the outputs.
+struct OutputView {
   Points positions;
   CapeMesh mesh;
   std::vector<Collider> colliders;
-  void turn(const Cape& cape, const std::vector<Collider>& world, const Eigen::Matrix3f& toScene) {
-    positions = cape.state().positions * toScene.transpose();
-    if (mesh.positions.rows() == 0) mesh.allocate(cape.fabric(), false);
-    mesh.update(cape.fabric(), positions);
-    const Quat turn(toScene);
-    colliders = world;
+  void set(const Fabric& fabric, const Points& x, const std::vector<Collider>& from,
+           const Eigen::Vector3d& offset, const Eigen::Matrix3f& turn) {
+    positions.resize(x.rows(), 3);
+    for (int c = 0; c < 3; ++c)
+      positions.col(c) = (x.col(c).cast<double>().array() + offset[c]).cast<float>().matrix();
+    positions = positions * turn.transpose();
+    if (mesh.positions.rows() == 0) mesh.allocate(fabric, false);
+    mesh.update(fabric, positions);
+    const Quat q(turn);
+    colliders = from;
     for (Collider& c : colliders) {
       for (Pose* p : {&c.previous, &c.current}) {
-        p->position = toScene * p->position;
-        p->rotation = (turn * p->rotation).normalized();
+        p->position = turn * (p->position.cast<double>() + offset).cast<float>();
+        p->rotation = (q * p->rotation).normalized();
       }
     }
   }
@@ -155,7 +161,10 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::vector<YUpView> views(static_cast<std::size_t>(run->characterCount()));
+  // Per character: the cape and its colliders in the scene's frame (when the cape's frame is elsewhere), and
+  // turned Y-up (a Z-up world, for glTF and the renderer).
+  std::vector<OutputView> shifted(static_cast<std::size_t>(run->characterCount()));
+  std::vector<OutputView> views(shifted.size());
   const Eigen::Matrix3f toScene = character::Skeleton::sceneToWorld(o.up).transpose().cast<float>();
   // The summary, streamed: per character, the worst character's (the table's) and the timings.
   std::vector<MetricsRecorder> recorders(static_cast<std::size_t>(run->characterCount()));
@@ -179,26 +188,42 @@ int main(int argc, char** argv) {
     row.capeTimeUs = run->lastCapeTimeUs();
     std::vector<Collider> allColliders;
     for (int k = 0; k < run->characterCount(); ++k) {
-      const std::vector<Collider> colliders = run->bodyColliders(k);
+      // The metrics in the cape's frame (precise however far away the character is)...
+      const Cape& cape = run->cape(k);
+      const std::vector<Collider> frameColliders = run->bodyColliders(k);
       const FrameMetrics m =
-          measureFrame(run->cape(k), colliders, run->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
+          measureFrame(cape, frameColliders, run->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
       recorders[static_cast<std::size_t>(k)].add(m);
-      if (run->cape(k).state().positions.rows() > 0)
-        lowest = std::min(lowest, static_cast<double>((run->cape(k).state().positions * up).minCoeff()));
       row.metrics = k == 0 ? m : worstOf(row.metrics, m);  // a crowd's row holds the worst of its characters
-      if (kept) writer->capeMesh(f, k, run->cape(k));
+      // ...the outputs in the scene's.
+      const Eigen::Vector3d offset = run->frameOffset(k);
+      const Points* x = &cape.state().positions;
+      const std::vector<Collider>* colliders = &frameColliders;
+      if (!offset.isZero()) {
+        OutputView& s = shifted[static_cast<std::size_t>(k)];
+        s.set(cape.fabric(), *x, frameColliders, offset, Eigen::Matrix3f::Identity());
+        x = &s.positions;
+        colliders = &s.colliders;
+      }
+      if (x->rows() > 0) lowest = std::min(lowest, static_cast<double>((*x * up).minCoeff()));
+      if (kept) writer->capeMesh(f, k, cape.fabric(), *x);
       if (o.up == character::UpAxis::Y) {
-        if (gltfRecorder) gltfRecorder->record(k, run->cape(k), colliders);
-        if (renderer) renderer->record(k, run->cape(k), colliders);
+        if (gltfRecorder) gltfRecorder->record(k, cape.fabric(), *x, *colliders);
+        if (renderer) {
+          OutputView& v = views[static_cast<std::size_t>(k)];
+          if (v.mesh.positions.rows() == 0) v.mesh.allocate(cape.fabric(), false);
+          v.mesh.update(cape.fabric(), *x);
+          renderer->record(k, v.mesh, *colliders);
+        }
       } else if (gltfRecorder || renderer) {
         // glTF and the renderer are Y-up: a Z-up world is turned back into the scene frame for them.
-        YUpView& v = views[static_cast<std::size_t>(k)];
-        v.turn(run->cape(k), colliders, toScene);
-        if (gltfRecorder) gltfRecorder->record(k, run->cape(k).fabric(), v.positions, v.colliders);
+        OutputView& v = views[static_cast<std::size_t>(k)];
+        v.set(cape.fabric(), *x, *colliders, Eigen::Vector3d::Zero(), toScene);
+        if (gltfRecorder) gltfRecorder->record(k, cape.fabric(), v.positions, v.colliders);
         if (renderer) renderer->record(k, v.mesh, v.colliders);
       }
       if (!kept) continue;
-      for (Collider c : colliders) {
+      for (Collider c : *colliders) {
         if (run->characterCount() > 1) c.name = "k" + std::to_string(k) + "/" + c.name;
         allColliders.push_back(std::move(c));
       }
