@@ -155,12 +155,38 @@ Status checkLimits(const UrdfLimits& limits) {
     if (value < 1)
       return Status::error(ErrorCode::InvalidArgument, std::string("UrdfLimits::") + field + " is 0");
   }
+  if (!(std::isfinite(limits.maxLength) && limits.maxLength > 0.0))
+    return Status::error(ErrorCode::InvalidArgument, "UrdfLimits::maxLength must be finite and > 0 (m)");
   if (limits.maxXmlDepth > kMaxXmlDepthCeiling) {
     return Status::error(ErrorCode::InvalidArgument, "UrdfLimits::maxXmlDepth is " +
                                                          std::to_string(limits.maxXmlDepth) + "; at most " +
                                                          std::to_string(kMaxXmlDepthCeiling) +
                                                          " (urdfdom's parser recurses once per level)");
   }
+  return Status::success();
+}
+
+// Every length of the built model within UrdfLimits::maxLength (joint and shape offsets, sizes, hull
+// vertices): a number urdfdom and our reader accept as finite may still be far beyond any robot.
+Status checkLengths(const UrdfModel& model, double maxLength) {
+  char limit[64];
+  std::snprintf(limit, sizeof limit, "; the limit is %g m (UrdfLimits::maxLength)", maxLength);
+  const auto far = [&](const Eigen::Vector3d& v) { return !(v.cwiseAbs().maxCoeff() <= maxLength); };
+  const auto big = [&](double v) { return !(std::abs(v) <= maxLength); };
+  for (const JointDesc& j : model.joints())
+    if (far(j.origin.translation()))
+      return Status::error(ErrorCode::InvalidModel, "joint '" + j.name + "' has an origin offset beyond " +
+                                                        "the length limit" + limit);
+  for (const LinkDesc& l : model.links())
+    for (const ShapeDesc& shape : l.shapes) {
+      bool beyond = far(shape.origin.translation()) || big(shape.radius) || big(shape.halfLength) ||
+                    far(shape.halfExtents);
+      for (const Eigen::Vector3d& v : shape.hull) beyond = beyond || far(v);
+      if (beyond)
+        return Status::error(ErrorCode::InvalidModel, "link '" + l.name + "': collision element '" +
+                                                          shape.name + "' has a length beyond the limit" +
+                                                          limit);
+    }
   return Status::success();
 }
 
@@ -572,6 +598,7 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xmlIn, const UrdfLoadOpt
         Status::error(ErrorCode::InvalidModel, std::string("URDF could not be read: ") + e.what());
   }
   release(parsed);
+  if (result.status.ok()) result.status = checkLengths(*model, options.limits.maxLength);
   if (result.status.ok()) {
     UrdfModelBuilder::standUp(*model, options.modelUp);
     result.model = std::move(model);

@@ -159,7 +159,10 @@ bool BulletScene::loadModel(const RunOptions& o, std::string& error) {
       o.urdf.empty() ? character::UrdfModel::humanoid() : character::UrdfModel::fromFile(o.urdf, load);
   warnings_ = loaded.warnings;  // also when the load failed: they may say why
   if (!loaded.ok()) {
-    error = (o.urdf.empty() ? std::string("shipped humanoid") : o.urdf) + ": " + loaded.status.message();
+    // fromFile's messages already begin with the file's path.
+    const std::string& m = loaded.status.message();
+    const bool named = !o.urdf.empty() && m.rfind(o.urdf, 0) == 0;
+    error = named ? m : (o.urdf.empty() ? std::string("shipped humanoid") : o.urdf) + ": " + m;
     return false;
   }
   model_ = loaded.model;

@@ -10,6 +10,7 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 
 using namespace cape::character;
@@ -100,6 +101,7 @@ TEST(UrdfLimits, DefaultsAreDocumentedValuesAndTheShippedHumanoidLoadsWithinThem
   EXPECT_EQ(limits.maxJoints, 10000u);
   EXPECT_EQ(limits.maxCollisionElements, 100000u);
   EXPECT_EQ(limits.maxMeshTriangles, 4000000u);
+  EXPECT_EQ(limits.maxLength, 1000.0);
   EXPECT_TRUE(UrdfModel::humanoid().ok());
 }
 
@@ -366,4 +368,35 @@ TEST(UrdfLimits, ElementsHiddenInADeclarationOrAProcessingInstructionAreNotReadB
     EXPECT_EQ(r.model->links().size(), 1u);
     EXPECT_TRUE(r.model->joints().empty());
   }
+}
+
+TEST(UrdfLimits, LengthsBeyondAnyRobotAreRefusedNamingTheLimit) {
+  // The shipped humanoid with a shoulder sphere of 1e30 m, or a shoulder 1e30 m from the torso: once a walk
+  // that ran to exit 0 with 412 % strain.
+  const std::string humanoid = UrdfModel::humanoidUrdf();
+  const auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string text = humanoid;
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  };
+  const std::string cases[] = {
+      replaced("<sphere radius=\"0.08\"/>", "<sphere radius=\"1e30\"/>"),
+      replaced("xyz=\"0 0.22 0.57\"", "xyz=\"0 1e30 0.57\""),
+      replaced("<sphere radius=\"0.08\"/>", "<box size=\"1 2.2e3 1\"/>"),
+      replaced("<sphere radius=\"0.08\"/>", "<sphere radius=\"1001\"/>"),
+  };
+  for (const std::string& text : cases) {
+    const UrdfLoadResult r = UrdfModel::fromString(text);
+    EXPECT_EQ(r.status.code(), ErrorCode::InvalidModel) << r.status.message();
+    EXPECT_TRUE(has(r.status.message(), "UrdfLimits::maxLength")) << r.status.message();
+  }
+  // Within the limit, or with it raised, the same file loads.
+  EXPECT_TRUE(UrdfModel::fromString(replaced("<sphere radius=\"0.08\"/>", "<sphere radius=\"999\"/>")).ok());
+  UrdfLimits wide;
+  wide.maxLength = 1e31;
+  EXPECT_TRUE(UrdfModel::fromString(cases[1], withLimits(wide)).ok());
+  UrdfLimits bad;
+  bad.maxLength = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(UrdfModel::fromString(humanoid, withLimits(bad)).status.code(), ErrorCode::InvalidArgument);
 }

@@ -99,6 +99,11 @@ struct UrdfLimits {
   /// its file (every node instance), also when another element uses the same file. InvalidModel. A detailed
   /// visual mesh is 100,000 to 500,000 triangles; a collision mesh a few thousand.
   std::size_t maxMeshTriangles = 4000000;
+  /// m: the largest length the model may hold: every joint origin's offset and every collision element's
+  /// (along any axis), every shape's radius, length and box size, every hull vertex (a mesh's scale
+  /// applied). InvalidModel. A robot is metres; a 1e30 m offset or sphere is a broken file, and no float
+  /// pipeline downstream (Bullet's, the cape's) can simulate it. Finite and > 0.
+  double maxLength = 1000.0;
 };
 
 /// How a URDF's mesh collision elements are found and made into hulls, and the limits of what is read.
