@@ -49,6 +49,14 @@ class BulletCapeRun final : public SceneRun {
     frameUs_ = scene_->stepFrame(frame_ / 60.0);
     capeUs_ = 0.0;
     for (auto& c : capes_) capeUs_ += c->takeAccumulatedMicroseconds();
+    guardTotals_.resize(capes_.size(), 0);
+    guardLastFrame_.resize(capes_.size(), 0);
+    for (std::size_t k = 0; k < capes_.size(); ++k) {
+      const std::uint64_t total = capes_[k]->cape().guard().total;
+      guardLastFrame_[k] =
+          static_cast<std::uint32_t>(std::min<std::uint64_t>(total - guardTotals_[k], 0xffffffffu));
+      guardTotals_[k] = total;
+    }
     // With several workers the capes run at once: their summed work overstates the wall time they took.
     if (group_->threadCount() > 1) capeUs_ = std::min(capeUs_, frameUs_);
   }
@@ -58,6 +66,9 @@ class BulletCapeRun final : public SceneRun {
   }
   Vec3 torsoCentre(int k) const override {
     return scene_->torsoCentre(k, capes_[static_cast<std::size_t>(k)]->frameOrigin());
+  }
+  std::uint32_t guardRestoredLastFrame(int k) const override {
+    return guardLastFrame_.empty() ? 0 : guardLastFrame_[static_cast<std::size_t>(k)];
   }
   Eigen::Vector3d frameOffset(int k) const override {
     return capes_[static_cast<std::size_t>(k)]->frameOrigin() - scene_->origin();
@@ -72,6 +83,8 @@ class BulletCapeRun final : public SceneRun {
   std::unique_ptr<BulletScene> scene_;
   std::unique_ptr<bullet::CapeGroup> group_;
   std::vector<std::unique_ptr<bullet::CapeAction>> capes_;
+  std::vector<std::uint64_t> guardTotals_;     ///< each cape's Cape::guard().total after the last frame
+  std::vector<std::uint32_t> guardLastFrame_;  ///< what the guard restored in the last frame
   int frame_ = 0;
   double frameUs_ = 0.0, capeUs_ = 0.0;
 };

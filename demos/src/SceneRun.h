@@ -55,6 +55,8 @@ class SceneRun {
   /// The cape's frame less the scene's origin (--origin), m: what turns the cape's frame coordinates into
   /// the scene's, in which every output is written (the ground through the scene's origin).
   virtual Eigen::Vector3d frameOffset(int character) const = 0;
+  /// Particles the cape's numerical guard restored during the last frame (Cape::guard()).
+  virtual std::uint32_t guardRestoredLastFrame(int character) const = 0;
   /// Wall time of the last frame, and the cape solver's share of it, µs.
   virtual double lastFrameTimeUs() const = 0;
   virtual double lastCapeTimeUs() const = 0;

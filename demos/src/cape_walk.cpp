@@ -191,8 +191,11 @@ int main(int argc, char** argv) {
       // The metrics in the cape's frame (precise however far away the character is)...
       const Cape& cape = run->cape(k);
       const std::vector<Collider> frameColliders = run->bodyColliders(k);
-      const FrameMetrics m =
+      FrameMetrics m =
           measureFrame(cape, frameColliders, run->torsoCentre(k), &counters[static_cast<std::size_t>(k)]);
+      // What the numerical guard restored this frame was a blow-up it kept from lasting.
+      m.guardRestored = run->guardRestoredLastFrame(k);
+      m.blowUp = m.blowUp || m.guardRestored > 0;
       recorders[static_cast<std::size_t>(k)].add(m);
       row.metrics = k == 0 ? m : worstOf(row.metrics, m);  // a crowd's row holds the worst of its characters
       // ...the outputs in the scene's.
@@ -302,11 +305,12 @@ int main(int argc, char** argv) {
   std::printf("  %-34s %10.3f m\n", "lowest particle above the ground", std::isfinite(lowest) ? lowest : 0.0);
   if (o.scene == SceneKind::Hang)
     std::printf("  %-34s %10.4f m/s\n", "rest jitter (last second)", q.restJitter);
-  std::printf("  %-34s %10s\n", "blow-up", q.blowUp ? "YES" : "no");
+  std::printf("  %-34s %10s  (numerical guard: %" PRId64 " particles restored in %" PRId64 " frames)\n",
+              "blow-up", q.blowUp ? "YES" : "no", q.guardRestored, q.framesGuardRestored);
   if (blowUp) {
     std::fprintf(stderr,
                  "cape_walk: the cape blew up at frame %" PRId64
-                 " (NaN or a particle > 10 m from the torso)\n",
+                 " (NaN, a particle > 10 m from the torso, or particles the numerical guard restored)\n",
                  framesRun);
     return 2;
   }

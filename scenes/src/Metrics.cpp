@@ -214,6 +214,7 @@ FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b) {
   m.selfIntersections = std::max(a.selfIntersections, b.selfIntersections);
   m.pinError = std::max(a.pinError, b.pinError);
   m.meanSpeed = std::max(a.meanSpeed, b.meanSpeed);
+  m.guardRestored = std::max(a.guardRestored, b.guardRestored);
   m.blowUp = a.blowUp || b.blowUp;
   return m;
 }
@@ -296,6 +297,8 @@ void MetricsRecorder::add(const FrameMetrics& f) {
   r.maxStrain = r.frames == 0 ? f.maxStrain : std::max(r.maxStrain, f.maxStrain);
   ++r.frames;
   r.blowUp = r.blowUp || f.blowUp;
+  r.guardRestored += f.guardRestored;
+  r.framesGuardRestored += f.guardRestored > 0 ? 1 : 0;
   meanStrainSum_ += f.meanStrain;
   frameMaxStrain_.add(f.maxStrain);
   r.maxPenetration = std::max(r.maxPenetration, f.maxPenetration);

@@ -102,10 +102,13 @@ TEST(Metrics, RecorderSummarisesFrames) {
     m.selfIntersections = i == 3 ? 4 : 0;
     m.pinError = 1e-6f;
     m.meanSpeed = i > 18 ? 0.1f : 1.0f;
+    m.guardRestored = i == 5 || i == 9 ? 3u : 0u;
     rec.add(m);
   }
   const RunSummary s = rec.summary();
   EXPECT_EQ(s.frames, 20);
+  EXPECT_EQ(s.guardRestored, 6);
+  EXPECT_EQ(s.framesGuardRestored, 2);
   EXPECT_FLOAT_EQ(s.maxStrain, 0.2f);
   EXPECT_NEAR(s.medianFrameMaxStrain, 0.10f, 0.0051f);
   EXPECT_FLOAT_EQ(s.p95FrameMaxStrain, 0.19f);

@@ -20,7 +20,7 @@ void expectRunFolder(const fs::path& dir, int frames, int n, int characters, int
   const auto columns = [](const std::string& l) { return 1 + std::count(l.begin(), l.end(), ','); };
   for (const std::string& l : csv) EXPECT_EQ(columns(l), columns(csv[0]));
   for (const char* name : {"frame", "max_strain", "mean_strain", "max_penetration_m", "self_intersections",
-                           "pin_error_m", "blow_up"})
+                           "pin_error_m", "blow_up", "guard_restored"})
     EXPECT_NE(csv[0].find(name), std::string::npos) << name << " missing from " << csv[0];
 
   // colliders.jsonl: one object per frame, every collider with its type's fields.
@@ -68,11 +68,12 @@ void expectRunFolder(const fs::path& dir, int frames, int n, int characters, int
   const json s = json::parse(in);
   EXPECT_EQ(s["grid"]["particles"].get<int>(), n * n);
   EXPECT_EQ(s["characters"].get<int>(), characters);
-  for (const char* key :
-       {"frame_time_us_median", "cape_time_us_median", "max_strain", "max_penetration_m",
-        "frames_penetration_over_1mm", "self_intersections_max", "pin_error_max_m", "blow_up"})
+  for (const char* key : {"frame_time_us_median", "cape_time_us_median", "max_strain", "max_penetration_m",
+                          "frames_penetration_over_1mm", "self_intersections_max", "pin_error_max_m",
+                          "blow_up", "guard_restored_particles", "frames_guard_restored"})
     EXPECT_TRUE(s["summary"].contains(key)) << key;
   EXPECT_FALSE(s["summary"]["blow_up"].get<bool>());
+  EXPECT_EQ(s["summary"]["guard_restored_particles"].get<int>(), 0) << "a healthy run never trips the guard";
 }
 
 TEST(CapeWalk, SimpleBodyWalkWritesEveryOutput) {

@@ -57,6 +57,9 @@ struct FrameMetrics {
   int selfIntersections = 0;
   float pinError = 0.0f;
   float meanSpeed = 0.0f;  ///< m/s, over particles
+  /// Particles the cape's numerical guard restored in the frame's steps (Cape::guard(): not finite, or run
+  /// away from the pins). The guard keeps the NaN from lasting; the frame counts as blown up all the same.
+  std::uint32_t guardRestored = 0;
   bool blowUp = false;
 };
 
@@ -89,6 +92,8 @@ struct RunSummary {
   int selfIntersectionsMax = 0;
   std::int64_t framesWithSelfIntersections = 0;
   float pinErrorMax = 0.0f;
+  std::int64_t guardRestored = 0;        ///< particles the numerical guard restored, over the run
+  std::int64_t framesGuardRestored = 0;  ///< frames in which it restored any
   bool blowUp = false;
   float restJitter = 0.0f;  ///< mean particle speed over the last second, m/s
 };
