@@ -209,3 +209,43 @@ TEST(Frame, TheWindIsTheWorldsWhereverTheFrameIs) {
 
 }  // namespace
 }  // namespace cape
+
+namespace cape {
+namespace {
+
+TEST(Guard, AParticleFarAwayWithSelfCollisionOnIsSearchedWithoutOverflowAndRestored) {
+  // The self-collision hash once floored a far particle's box into ints and overflowed their difference
+  // (signed overflow, caught by UBSan; found by the fabric fuzz target).
+  FabricPtr fabric = test::makeGrid(8, 8, 0.3f, 0.3f);
+  CapeSettings s;
+  s.selfCollision = true;
+  Cape cape(fabric, s);
+  cape.pin(0, test::row(cape.state().positions, 0));
+  cape.pin(7, test::row(cape.state().positions, 7));
+  for (const float far : {3e9f, -3e9f, 1e30f, std::numeric_limits<float>::infinity()}) {
+    cape.mutableState().positions(40, 0) = far;
+    cape.mutableState().positions(41, 1) = -far;
+    cape.step(1.0f / 60.0f, {});
+    EXPECT_TRUE(cape.state().positions.allFinite()) << far;
+    EXPECT_LT(cape.state().positions.cwiseAbs().maxCoeff(), 2.0f) << far;
+  }
+  EXPECT_GE(cape.guard().total, 8u);
+}
+
+TEST(Fabric, VerticesTooFarApartForAFloatAreRefused) {
+  // 1e30 m apart: the spring's rest length was computed as inf (its square overflowed) and accepted.
+  MeshDesc d;
+  d.positions = {Vec3(0.0f, 0.0f, 0.0f), Vec3(1e30f, 0.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)};
+  d.triangles = {0, 1, 2};
+  const FabricResult r = Fabric::fromMesh(d);
+  EXPECT_FALSE(r);
+  EXPECT_NE(r.status.message().find("1e6 m"), std::string::npos) << r.status.message();
+  d.positions[1] = Vec3(1e6f, 0.0f, 0.0f);
+  EXPECT_TRUE(Fabric::fromMesh(d)) << "a kilometre-sized sheet is still a fabric";
+  GridDesc g;
+  g.width = 1e30f;
+  EXPECT_FALSE(Fabric::grid(g));
+}
+
+}  // namespace
+}  // namespace cape

@@ -126,8 +126,10 @@ FabricResult Fabric::grid(const GridDesc& d) {
     result.status = Status::error("Fabric::grid: too many particles");
     return result;
   }
-  if (!finitePositive(d.width) || !finitePositive(d.height) || !finitePositive(d.totalMass)) {
-    result.status = Status::error("Fabric::grid: width, height and total mass must be finite and > 0");
+  if (!finitePositive(d.width) || !finitePositive(d.height) || !finitePositive(d.totalMass) ||
+      d.width > kMaxFabricCoordinate || d.height > kMaxFabricCoordinate) {
+    result.status = Status::error(
+        "Fabric::grid: width, height and total mass must be finite and > 0, the sizes at most 1e6 m");
     return result;
   }
   std::shared_ptr<Fabric> f(new Fabric());
@@ -203,8 +205,9 @@ FabricResult Fabric::fromMesh(const MeshDesc& d) {
     return result;
   }
   for (const Vec3& p : d.positions) {
-    if (!p.allFinite()) {
-      result.status = Status::error("Fabric::fromMesh: a vertex position is not finite");
+    if (!p.allFinite() || !(p.cwiseAbs().maxCoeff() <= kMaxFabricCoordinate)) {
+      result.status = Status::error(
+          "Fabric::fromMesh: a vertex position is not finite or beyond +-1e6 m (kMaxFabricCoordinate)");
       return result;
     }
   }
@@ -281,6 +284,11 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
     set.restLength.resize(set.size());
     for (std::size_t s = 0; s < set.size(); ++s) {
       const float len = (restPositions_.row(set.first[s]) - restPositions_.row(set.second[s])).norm();
+      if (!std::isfinite(len)) {
+        return Status::error("Fabric: spring between particles " + std::to_string(set.first[s]) + " and " +
+                             std::to_string(set.second[s]) + " is too long for a float (keep the fabric's " +
+                             "coordinates within +-1e6 m)");
+      }
       if (!(len > 1e-7f)) {
         return Status::error("Fabric: spring between particles " + std::to_string(set.first[s]) + " and " +
                              std::to_string(set.second[s]) + " has zero rest length");

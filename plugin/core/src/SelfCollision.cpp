@@ -11,7 +11,9 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #if defined(__SSE2__)
@@ -96,12 +98,20 @@ inline bool cellsOf(float invCell, float lx, float ly, float lz, float hx, float
 #else
   const float v[6] = {lx, ly, lz, hx, hy, hz};
   for (int k = 0; k < 6; ++k) {
+    // Clamped as cvttps does (far or NaN: the most negative int), so the cast is defined.
     const float f = v[k] * invCell;
-    const int i = static_cast<int>(f);
+    const int i = f >= -2147483648.0f && f < 2147483648.0f ? static_cast<int>(f) : INT_MIN;
     c[k < 3 ? k : k + 1] = i - (f < static_cast<float>(i) ? 1 : 0);
   }
 #endif
-  return c[4] - c[0] <= kMaxSpan && c[5] - c[1] <= kMaxSpan && c[6] - c[2] <= kMaxSpan;
+  // A box far out (or not finite: cells at the ints' ends, where the floor correction wraps) is not binned,
+  // so neither its span nor the loops over its cells can overflow.
+  constexpr std::int64_t kFar = std::int64_t(1) << 30;
+  for (int k = 0; k < 3; ++k) {
+    const std::int64_t lo = c[k], hi = c[k + 4];
+    if (lo < -kFar || hi > kFar || hi < lo || hi - lo > kMaxSpan) return false;
+  }
+  return true;
 }
 
 /// Whether particle q is local to a triangle (its corners and the far corners across its edges): it reaches

@@ -79,8 +79,12 @@ struct GridDesc {
 };
 
 /// How to build a fabric from any triangle mesh (an artist's cape).
+/// The largest rest coordinate a fabric may have, m: a fabric is metres; beyond this a float square (a
+/// spring's squared length) overflows.
+constexpr float kMaxFabricCoordinate = 1e6f;
+
 struct MeshDesc {
-  std::vector<Vec3> positions;  ///< Rest positions, m.
+  std::vector<Vec3> positions;  ///< Rest positions, m, each coordinate within +-kMaxFabricCoordinate.
   std::vector<std::uint32_t>
       triangles;                     ///< Three indices per triangle, counter-clockwise seen from the front.
   std::vector<Eigen::Vector2f> uvs;  ///< Optional, one per vertex.
