@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -134,6 +135,40 @@ TEST(CapeFrame, TheGuardsWorkIsSaidOnceAndTheCapeRecovers) {
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("numerical guard"), std::string::npos) << warnings[0];
   w.world->removeAction(&action);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(CapeFrame, ABodyPoseThatIsNotFiniteForAFrameLeavesNoLastingNaN) {
+  using capetest::World;
+  const btScalar nan = std::numeric_limits<btScalar>::quiet_NaN();
+  const btScalar inf = std::numeric_limits<btScalar>::infinity();
+  for (const btVector3& bad :
+       {btVector3(nan, 1.5f, 0), btVector3(inf, -inf, 0), btVector3(1e38f, 1e38f, 1e38f)}) {
+    World w;
+    const btTransform start(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0));
+    btRigidBody* body = w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)), start);
+    CapeAction action(capetest::cornerFabric(), cape::CapeSettings(),
+                      btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.56f, 0.15f)));
+    action.setWarningHandler([](const std::string&) {});
+    action.attach(0, body, btVector3(-0.3f, 0.06f, 0.15f));
+    action.attach(19, body, btVector3(0.3f, 0.06f, 0.15f));
+    w.world->addAction(&action);
+    for (int frame = 0; frame < 60; ++frame) w.world->stepSimulation(capetest::kFrame, 8, capetest::kFixed);
+    World::moveKinematic(body, btTransform(btQuaternion::getIdentity(), bad));
+    w.world->stepSimulation(capetest::kFrame, 8, capetest::kFixed);
+    EXPECT_TRUE(action.cape().state().positions.allFinite()) << "a NaN never outlives the step";
+    World::moveKinematic(body, start);
+    w.world->stepSimulation(capetest::kFrame, 8, capetest::kFixed);
+    // One frame after the body is back, the cape hangs from it again.
+    ASSERT_TRUE(action.cape().state().positions.allFinite());
+    EXPECT_LT(action.maxPinError(), btScalar(1e-3));
+    for (std::size_t i = 0; i < action.particleCount(); ++i)
+      ASSERT_LT((action.position(std::uint32_t(i)) - start.getOrigin()).length(), 1.5f) << i;
+    w.world->removeAction(&action);
+  }
 }
 
 }  // namespace
