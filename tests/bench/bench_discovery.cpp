@@ -48,9 +48,8 @@ void BM_DiscoveryWalkFrame(benchmark::State& state) {
         },
         other.world.get(), true);
   }
-  w.addStatic(new btStaticPlaneShape(btVector3(0, 1, 0), 0), btTransform::getIdentity());
   // The walk goes on without restarting (a restart would teleport the cape): the boxes stay >= 60 m away.
-  SimpleWalk walk(w);
+  SimpleWalk walk(w, btVector3(0, 0, 0), cape::bullet::CapeActionSettings(), true);
   cape::bullet::CapeAction& action = *walk.action;
   const auto advance = [&]() { walk.advance(); };
   // Warm up one simulated second so that the cape is in contact with the body, as in the other benchmarks.

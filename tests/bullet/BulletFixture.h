@@ -143,11 +143,12 @@ inline btTransform horizontalAt(btScalar y) {
 
 /// docs/SCENES.md's walk on kinematic Bullet bodies in `world`: a torso box, shoulder spheres and leg
 /// capsules moved rigidly with the character frame, the canonical cape pinned by its corners to the
-/// shoulders, the whole scene moved by `offset`; advance() is one 1/60 s frame, stepSimulation(1/60, 8,
-/// 1/240).
+/// shoulders, the whole scene moved by `offset` (and, with `ground`, a static ground plane through it);
+/// advance() is one 1/60 s frame, stepSimulation(1/60, 8, 1/240).
 struct SimpleWalk {
   SimpleWalk(World& w, const btVector3& offset = btVector3(0, 0, 0),
-             const cape::bullet::CapeActionSettings& settings = cape::bullet::CapeActionSettings())
+             const cape::bullet::CapeActionSettings& settings = cape::bullet::CapeActionSettings(),
+             bool ground = false)
       : world(w),
         shift(btQuaternion::getIdentity(), offset),
         motion(cape::MotionDesc::forScene(cape::SceneKind::Walk)) {
@@ -161,6 +162,8 @@ struct SimpleWalk {
     btRigidBody* right = part(new btSphereShape(0.08f), btVector3(0.22f, 1.52f, 0));
     part(new btCapsuleShape(0.07f, 0.66f), btVector3(-0.1f, 0.55f, 0));
     part(new btCapsuleShape(0.07f, 0.66f), btVector3(0.1f, 0.55f, 0));
+    if (ground)
+      w.addStatic(new btStaticPlaneShape(btVector3(0, 1, 0), offset.y()), btTransform::getIdentity());
     const cape::CapeRig rig = cape::makeCapeRig(20, cape::PinLayout::Corners);
     action = std::make_unique<cape::bullet::CapeAction>(
         rig.fabric, cape::CapeSettings(),

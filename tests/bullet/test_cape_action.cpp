@@ -541,41 +541,17 @@ TEST(CapeAction, DebugDrawDrawsEveryTriangleEdge) {
 TEST(CapeAction, WalkOnTheSimpleBodyPinnedToTheShoulders) {
   // docs/SCENES.md's walk on kinematic Bullet bodies (torso, shoulders, legs as rigid parts of the moving
   // character frame; the legs do not swing here), the cape pinned by its corners to the shoulder spheres,
-  // stepped by stepSimulation(1/60, 8, 1/240) for 2 s.
+  // over the ground, stepped by stepSimulation(1/60, 8, 1/240) for 2 s.
   World w;
-  std::vector<std::pair<btRigidBody*, btTransform>> parts;
-  auto part = [&](btCollisionShape* s, const btVector3& at) {
-    const btTransform local(btQuaternion::getIdentity(), at);
-    parts.push_back({w.addKinematic(s, local), local});
-    return parts.back().first;
-  };
-  part(new btBoxShape(btVector3(0.2f, 0.3f, 0.12f)), btVector3(0, 1.25f, 0));
-  btRigidBody* left = part(new btSphereShape(0.08f), btVector3(-0.22f, 1.52f, 0));
-  btRigidBody* right = part(new btSphereShape(0.08f), btVector3(0.22f, 1.52f, 0));
-  part(new btCapsuleShape(0.07f, 0.66f), btVector3(-0.1f, 0.55f, 0));
-  part(new btCapsuleShape(0.07f, 0.66f), btVector3(0.1f, 0.55f, 0));
-  w.addStatic(new btStaticPlaneShape(btVector3(0, 1, 0), 0), btTransform::getIdentity());
-
-  const cape::CapeRig rig = cape::makeCapeRig(20, cape::PinLayout::Corners);
-  CapeAction action(rig.fabric, cape::CapeSettings(),
-                    cape::bullet::toBt(cape::capeStartPlacement(cape::SceneKind::Walk)));
-  const btRigidBody* shoulders[2] = {left, right};
-  for (int k = 0; k < 2; ++k) {
-    const btVector3 world = cape::bullet::toBt(rig.pinLocalPoints[std::size_t(k)]);
-    ASSERT_TRUE(action.attach(rig.pinnedParticles[std::size_t(k)], shoulders[k],
-                              shoulders[k]->getWorldTransform().invXform(world)));
-  }
-  w.world->addAction(&action);
-  const cape::MotionDesc motion = cape::MotionDesc::forScene(cape::SceneKind::Walk);
+  SimpleWalk walk(w, btVector3(0, 0, 0), cape::bullet::CapeActionSettings(), true);
+  const CapeAction& action = *walk.action;
   double worstDepth = 0.0, worstPin = 0.0;
   float worstStrain = 0.0f;
   for (int frame = 1; frame <= 120; ++frame) {
-    const btTransform f = cape::bullet::toBt(cape::motionAt(motion, frame / 60.0).frame());
-    for (auto& p : parts) World::moveKinematic(p.first, f * p.second);
-    w.world->stepSimulation(kFrame, 8, kFixed);
+    walk.advance();
     worstPin = std::max(worstPin, double(action.maxPinError()));
     worstStrain = std::max(worstStrain, maxStructuralStrain(action.cape()));
-    for (auto& p : parts)
+    for (auto& p : walk.parts)
       for (std::size_t i = 0; i < action.particleCount(); ++i) {
         const btScalar d = cape::bullet::shapeSignedDistance(
             p.first->getCollisionShape(), p.first->getWorldTransform(), action.position(std::uint32_t(i)));
@@ -588,7 +564,6 @@ TEST(CapeAction, WalkOnTheSimpleBodyPinnedToTheShoulders) {
   EXPECT_LT(worstDepth, 1e-3);
   EXPECT_LT(worstStrain, 0.1f);
   RecordProperty("max_strain", std::to_string(worstStrain));
-  w.world->removeAction(&action);
 }
 
 // --- Discovery through the broadphase, bodies leaving the world (issue 12) --------------------------------

@@ -57,6 +57,36 @@ WalkFigures walkAt(const btVector3& offset, btScalar frameSpacing) {
   return out;
 }
 
+/// The canonical cape hanging by its top corners from a kinematic box 1.5 m up, settled for `frames`
+/// frames; the action's warnings are kept.
+struct HangingOnABox {
+  explicit HangingOnABox(int frames)
+      : start(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)),
+        body(w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)), start)),
+        action(cornerFabric(), cape::CapeSettings(),
+               btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.56f, 0.15f))) {
+    action.setWarningHandler([this](const std::string& m) { warnings.push_back(m); });
+    action.attach(0, body, btVector3(-0.3f, 0.06f, 0.15f));
+    action.attach(19, body, btVector3(0.3f, 0.06f, 0.15f));
+    w.world->addAction(&action);
+    for (int f = 0; f < frames; ++f) frame();
+  }
+  ~HangingOnABox() { w.world->removeAction(&action); }
+  void frame() { w.world->stepSimulation(kFrame, 8, kFixed); }
+  void moveTo(const btVector3& p) { World::moveKinematic(body, btTransform(btQuaternion::getIdentity(), p)); }
+  /// Every particle within 1.5 m of the box: hanging from it, not left behind or thrown away.
+  bool onTheBox() const {
+    for (std::size_t i = 0; i < action.particleCount(); ++i)
+      if (!((action.position(std::uint32_t(i)) - start.getOrigin()).length() < 1.5f)) return false;
+    return true;
+  }
+  World w;
+  btTransform start;
+  btRigidBody* body;
+  CapeAction action;
+  std::vector<std::string> warnings;
+};
+
 TEST(CapeFrame, AWalkTenKilometresAwayIsTheWalkAtTheOrigin) {
   // Bullet's bodies are floats: 10 km away their poses carry up to 0.5 mm of rounding, which the cape feels
   // through its pins (100 km away 4 mm: see docs/PERFORMANCE.md's figures). The cape adds none of its own.
@@ -85,89 +115,50 @@ TEST(CapeFrame, AWalkTenKilometresAwayIsTheWalkAtTheOrigin) {
 TEST(CapeFrame, ABodyThrownFarAwayAndBackBringsItsCapeBackIntact) {
   // Once: 50 of 400 particles NaN for good, silently.
   for (const btScalar far : {btScalar(1e6), btScalar(1e20), btScalar(1e30)}) {
-    World w;
-    const btTransform start(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0));
-    btRigidBody* body = w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)), start);
-    CapeAction action(cornerFabric(), cape::CapeSettings(),
-                      btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.56f, 0.15f)));
-    std::vector<std::string> warnings;
-    action.setWarningHandler([&](const std::string& m) { warnings.push_back(m); });
-    action.attach(0, body, btVector3(-0.3f, 0.06f, 0.15f));
-    action.attach(19, body, btVector3(0.3f, 0.06f, 0.15f));
-    w.world->addAction(&action);
-    for (int frame = 0; frame < 60; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
-    const float strainBefore = maxStructuralStrain(action.cape());
-    World::moveKinematic(body, btTransform(btQuaternion::getIdentity(), btVector3(far, 1.5f, 0)));
-    w.world->stepSimulation(kFrame, 8, kFixed);
-    ASSERT_TRUE(action.cape().state().positions.allFinite()) << far;
-    World::moveKinematic(body, start);
-    w.world->stepSimulation(kFrame, 8, kFixed);
+    HangingOnABox h(60);
+    const float strainBefore = maxStructuralStrain(h.action.cape());
+    h.moveTo(btVector3(far, 1.5f, 0));
+    h.frame();
+    ASSERT_TRUE(h.action.cape().state().positions.allFinite()) << far;
+    h.moveTo(h.start.getOrigin());
+    h.frame();
     // One frame after the body is back, the cape hangs from it as before.
-    ASSERT_TRUE(allFinite(action.positions())) << far;
-    EXPECT_LT(maxStructuralStrain(action.cape()), std::max(0.05f, 2.0f * strainBefore)) << far;
-    EXPECT_LT(action.maxPinError(), btScalar(1e-4)) << far;
-    for (std::size_t i = 0; i < action.particleCount(); ++i)
-      ASSERT_LT((action.position(std::uint32_t(i)) - start.getOrigin()).length(), 1.5f) << far << " " << i;
-    EXPECT_EQ(action.cape().guard().total, 0u) << "the frame carried the cape exactly: nothing to restore";
-    EXPECT_TRUE(warnings.empty()) << warnings.front();
-    w.world->removeAction(&action);
+    ASSERT_TRUE(allFinite(h.action.positions())) << far;
+    EXPECT_LT(maxStructuralStrain(h.action.cape()), std::max(0.05f, 2.0f * strainBefore)) << far;
+    EXPECT_LT(h.action.maxPinError(), btScalar(1e-4)) << far;
+    EXPECT_TRUE(h.onTheBox()) << far;
+    EXPECT_EQ(h.action.cape().guard().total, 0u) << "the frame carried the cape exactly: nothing to restore";
+    EXPECT_TRUE(h.warnings.empty()) << h.warnings.front();
   }
 }
 
 TEST(CapeFrame, TheGuardsWorkIsSaidOnceAndTheCapeRecovers) {
-  World w;
-  btRigidBody* body = w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)),
-                                     btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
-  CapeAction action(cornerFabric(), cape::CapeSettings(),
-                    btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.56f, 0.15f)));
-  std::vector<std::string> warnings;
-  action.setWarningHandler([&](const std::string& m) { warnings.push_back(m); });
-  action.attach(0, body, btVector3(-0.3f, 0.06f, 0.15f));
-  action.attach(19, body, btVector3(0.3f, 0.06f, 0.15f));
-  w.world->addAction(&action);
-  for (int frame = 0; frame < 30; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  HangingOnABox h(30);
   for (int k = 0; k < 3; ++k) {
-    action.cape().mutableState().positions(150 + k, 1) = std::numeric_limits<float>::quiet_NaN();
-    w.world->stepSimulation(kFrame, 8, kFixed);
-    ASSERT_TRUE(allFinite(action.positions()));
+    h.action.cape().mutableState().positions(150 + k, 1) = std::numeric_limits<float>::quiet_NaN();
+    h.frame();
+    ASSERT_TRUE(allFinite(h.action.positions()));
   }
-  EXPECT_GE(action.cape().guard().total, 3u);
-  ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_NE(warnings[0].find("numerical guard"), std::string::npos) << warnings[0];
-  w.world->removeAction(&action);
+  EXPECT_GE(h.action.cape().guard().total, 3u);
+  ASSERT_EQ(h.warnings.size(), 1u);
+  EXPECT_NE(h.warnings[0].find("numerical guard"), std::string::npos) << h.warnings[0];
 }
 
-}  // namespace
-
-namespace {
-
 TEST(CapeFrame, ABodyPoseThatIsNotFiniteForAFrameLeavesNoLastingNaN) {
-  using capetest::World;
   const btScalar nan = std::numeric_limits<btScalar>::quiet_NaN();
   const btScalar inf = std::numeric_limits<btScalar>::infinity();
   for (const btVector3& bad :
        {btVector3(nan, 1.5f, 0), btVector3(inf, -inf, 0), btVector3(1e38f, 1e38f, 1e38f)}) {
-    World w;
-    const btTransform start(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0));
-    btRigidBody* body = w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)), start);
-    CapeAction action(capetest::cornerFabric(), cape::CapeSettings(),
-                      btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.56f, 0.15f)));
-    action.setWarningHandler([](const std::string&) {});
-    action.attach(0, body, btVector3(-0.3f, 0.06f, 0.15f));
-    action.attach(19, body, btVector3(0.3f, 0.06f, 0.15f));
-    w.world->addAction(&action);
-    for (int frame = 0; frame < 60; ++frame) w.world->stepSimulation(capetest::kFrame, 8, capetest::kFixed);
-    World::moveKinematic(body, btTransform(btQuaternion::getIdentity(), bad));
-    w.world->stepSimulation(capetest::kFrame, 8, capetest::kFixed);
-    EXPECT_TRUE(action.cape().state().positions.allFinite()) << "a NaN never outlives the step";
-    World::moveKinematic(body, start);
-    w.world->stepSimulation(capetest::kFrame, 8, capetest::kFixed);
+    HangingOnABox h(60);
+    h.moveTo(bad);
+    h.frame();
+    EXPECT_TRUE(h.action.cape().state().positions.allFinite()) << "a NaN never outlives the step";
+    h.moveTo(h.start.getOrigin());
+    h.frame();
     // One frame after the body is back, the cape hangs from it again.
-    ASSERT_TRUE(action.cape().state().positions.allFinite());
-    EXPECT_LT(action.maxPinError(), btScalar(1e-3));
-    for (std::size_t i = 0; i < action.particleCount(); ++i)
-      ASSERT_LT((action.position(std::uint32_t(i)) - start.getOrigin()).length(), 1.5f) << i;
-    w.world->removeAction(&action);
+    ASSERT_TRUE(h.action.cape().state().positions.allFinite());
+    EXPECT_LT(h.action.maxPinError(), btScalar(1e-3));
+    EXPECT_TRUE(h.onTheBox());
   }
 }
 
