@@ -19,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -503,10 +504,151 @@ Eigen::Matrix4d toEigen(const aiMatrix4x4& m) {
   return t;
 }
 
+// --- COLLADA text checked before assimp
+// ------------------------------------------------------------------------------------------------
+//
+// Debian's assimp 5.2 reads a <p> index list (ColladaParser::ReadPrimitives) in a loop that ends only at the
+// text's end: each turn reads an integer (strtol10, which consumes a sign and digits) and skips spaces, tabs
+// and line ends. Any other character (a letter, '.', '*', a control byte, a character reference that
+// pugixml decodes) is consumed by neither, so the loop appends 0 indices until an allocation fails: 257 s
+// for a 1 KB file in Release. The post-processing steps play no part (it hangs the same with none). So a
+// file that assimp may read as COLLADA is checked here first, in one linear pass over its text, and refused
+// when assimp would loop or reserve without bound.
+
+bool isXmlSpace(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\n';
+}
+
+// What the index list reader consumes: digits and signs (strtol10), spaces, tabs and line ends.
+bool isIndexListChar(char c) {
+  return (c >= '0' && c <= '9') || c == '+' || c == '-' || isXmlSpace(c);
+}
+
+std::string describeByte(char c) {
+  static const char* const hex = "0123456789abcdef";
+  const unsigned u = static_cast<unsigned char>(c);
+  std::string out = "byte 0x";
+  out += hex[u >> 4];
+  out += hex[u & 15];
+  if (u > 32 && u < 127) out += std::string(" '") + c + "'";
+  return out;
+}
+
+// Whether assimp 5.2 may read the file as COLLADA: its ColladaLoader::CanRead takes the extensions dae, zae
+// and xml, a file with "<collada" in its first 200 bytes (NUL bytes dropped, any case) when no reader before
+// it claims the file, and a zip archive holding COLLADA (.zae). All of those are checked here (more than
+// assimp reads as COLLADA, never less). A file without an extension is taken by its content, as assimp
+// does (a binary STL without one is read by assimp's STL reader, and still is).
+bool readAsCollada(const std::string& path, const std::string& head) {
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".dae" || ext == ".zae" || ext == ".xml") return true;
+  if (startsWith(head, "PK")) return true;
+  std::string h;
+  for (char c : head)
+    if (c != '\0') h += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return h.find("<collada") != std::string::npos;
+}
+
+// The element starting at text[at] ('<') is named `name` (not a longer name with the same start).
+bool elementNamed(const std::string& text, std::size_t at, const char* name) {
+  const std::size_t n = std::strlen(name);
+  if (text.compare(at + 1, n, name) != 0 || at + 1 + n >= text.size()) return false;
+  const char next = text[at + 1 + n];
+  return next == '>' || next == '/' || isXmlSpace(next);
+}
+
+Status checkColladaText(const std::string& path, const std::string& text) {
+  const auto refuse = [&](std::size_t at, const std::string& what) {
+    return invalidModel(path,
+                        "COLLADA refused before assimp reads it (Debian's assimp 5.2 would loop or "
+                        "allocate without bound on it): " +
+                            what + " at byte " + std::to_string(at));
+  };
+  // XML allows no control byte but tab, line feed and carriage return. One here is UTF-16 or UTF-32 text or
+  // a zip archive (.zae), which assimp would convert or unpack unseen by these checks.
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const unsigned char u = static_cast<unsigned char>(text[i]);
+    if (u < 32 && u != '\t' && u != '\n' && u != '\r')
+      return refuse(i,
+                    describeByte(text[i]) +
+                        " (XML text has no control bytes; UTF-16, UTF-32 and zipped COLLADA are not read)");
+  }
+  // Every count="N" (arrays, accessors, primitives, skins): assimp reserves and reads N items, and each item
+  // takes at least one byte of the file, so a count beyond the file's size is refused. Strictly digits, as
+  // every exporter writes them (pugixml would also read hex, signs and character references).
+  for (std::size_t at = text.find("count"); at != std::string::npos; at = text.find("count", at + 1)) {
+    if (at == 0 || !isXmlSpace(text[at - 1])) continue;
+    std::size_t i = at + 5;
+    while (i < text.size() && isXmlSpace(text[i])) ++i;
+    if (i >= text.size() || text[i] != '=') continue;
+    ++i;
+    while (i < text.size() && isXmlSpace(text[i])) ++i;
+    if (i >= text.size() || (text[i] != '"' && text[i] != '\'')) continue;
+    const char quote = text[i++];
+    while (i < text.size() && isXmlSpace(text[i])) ++i;
+    std::uintmax_t value = 0;
+    std::size_t digits = 0;
+    for (; i < text.size() && text[i] >= '0' && text[i] <= '9'; ++i, ++digits)
+      if (value <= text.size()) value = 10 * value + static_cast<std::uintmax_t>(text[i] - '0');
+    while (i < text.size() && isXmlSpace(text[i])) ++i;
+    if (digits == 0 || i >= text.size() || text[i] != quote)
+      return refuse(at, "a count attribute that is not a plain decimal number");
+    if (value > text.size())
+      return refuse(at, "a count attribute larger than the file (" + std::to_string(text.size()) + " bytes)");
+  }
+  // Every <p> and <vcount> list: only what the reader consumes, up to its own end tag (no comments, CDATA,
+  // character references or elements inside). The sum of a <vcount> list (corners, each needing an index in
+  // the file) is bounded by the file's size like a count.
+  for (std::size_t at = text.find('<'); at != std::string::npos; at = text.find('<', at + 1)) {
+    const bool isP = elementNamed(text, at, "p");
+    if (!isP && !elementNamed(text, at, "vcount")) continue;
+    const char* name = isP ? "p" : "vcount";
+    const std::size_t close = text.find('>', at);
+    if (close == std::string::npos) return refuse(at, std::string("an unclosed <") + name + "> tag");
+    if (text[close - 1] == '/') continue;  // <p/>: empty
+    std::uintmax_t sum = 0, value = 0;
+    std::size_t i = close + 1;
+    for (; i < text.size() && text[i] != '<'; ++i) {
+      const char c = text[i];
+      if (!isIndexListChar(c))
+        return refuse(i, describeByte(c) + " in a <" + name + "> list (only digits, signs and white space)");
+      if (c >= '0' && c <= '9') {
+        if (value <= text.size()) value = 10 * value + static_cast<std::uintmax_t>(c - '0');
+      } else {
+        sum += std::min<std::uintmax_t>(value, text.size() + 1);
+        value = 0;
+      }
+    }
+    sum += std::min<std::uintmax_t>(value, text.size() + 1);
+    if (i >= text.size() || text.compare(i, 2 + std::strlen(name), std::string("</") + name) != 0)
+      return refuse(i, std::string("a <") + name + "> list that holds anything but its numbers");
+    if (!isP && sum > text.size())
+      return refuse(close + 1, "a <vcount> list whose corners outnumber the file's bytes");
+    at = i;
+  }
+  return Status::success();
+}
+
+// A file that assimp would read as COLLADA, checked (checkColladaText); any other passes.
+Status precheck(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(200, '\0');
+  in.read(&head[0], static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  if (!readAsCollada(path, head)) return Status::success();
+  in.clear();
+  in.seekg(0);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return invalidModel(path, "it cannot be read");
+  return checkColladaText(path, text);
+}
+
 // The file's triangles' corners, node transforms and scale applied, as distinct points.
 Status readMesh(const std::string& path, const Vec3& scale, const MeshHullOptions& options,
                 std::vector<Vec3>& points, int& triangles, bool& overTriangleLimit) {
   overTriangleLimit = false;
+  if (Status checked = precheck(path); !checked.ok()) return checked;
   Assimp::Importer importer;
   // COLLADA: assimp puts the <unit meter> scale and the <up_axis> rotation to its Y-up convention into the
   // root node's transform. URDF consumers (RViz skips the root node's transform and applies <unit meter>

@@ -337,6 +337,50 @@ TEST_F(MeshHullTest, ColladaUpAxisIsIgnoredAndTheUnitDefaultsToMetres) {
   expectBox(loadMeshHull(file("cm.dae"), Vector3d(2, 2, 2)), 2 * kLoM, 2 * kHiM, kFloatTol);
 }
 
+TEST_F(MeshHullTest, ColladaThatAssimpWouldLoopOnIsRefusedAndPlainIndexListsStillLoad) {
+  // Debian's assimp 5.2 reads a <p> list until its text ends, and a character that is neither a number nor
+  // white space stops it for good (it appends 0 indices until memory runs out: 257 s for such a 1 KB file).
+  // Such files are refused before assimp sees them; this test finishes at once or times out.
+  const std::string box = boxDae(kLoM, kHiM, 1, "Z_UP", {Vector3d::Zero()});
+  const std::size_t p = box.find("<p>") + 3;
+  ASSERT_NE(p, std::string::npos + 3);
+  const std::size_t space = box.find(' ', p + 6);
+  const auto edited = [&](const std::string& with) {
+    std::string s = box;
+    s.replace(space, 1, with);
+    return s;
+  };
+  const auto expectRefused = [&](const std::string& name, const std::string& text, const std::string& says) {
+    writeText(file(name), text);
+    const MeshHullResult r = loadMeshHull(file(name), Vector3d::Ones());
+    EXPECT_FALSE(r.ok()) << name;
+    EXPECT_EQ(r.status.code(), ErrorCode::InvalidModel) << r.status.message();
+    EXPECT_NE(r.status.message().find(name), std::string::npos) << r.status.message();
+    EXPECT_NE(r.status.message().find(says), std::string::npos) << r.status.message();
+  };
+  expectRefused("control.dae", edited("\x1e"), "byte 0x1e");
+  expectRefused("dot.dae", edited("."), "'.' in a <p> list");
+  expectRefused("word.dae", edited(" vertex "), "'v' in a <p> list");
+  expectRefused("reference.dae", edited("&#30;"), "'&' in a <p> list");
+  expectRefused("comment.dae", edited("<!-- x -->"), "anything but its numbers");
+  // assimp picks its COLLADA reader by content: the extension does not matter.
+  expectRefused("collada_named.stl", edited("*"), "'*' in a <p> list");
+  // A count beyond the file's size (assimp reserves that many) and one that is not a decimal number.
+  std::string huge = box;
+  huge.replace(huge.find("count=\"12\""), 10, "count=\"4000000000\"");
+  expectRefused("huge_count.dae", huge, "count attribute larger than the file");
+  std::string hex = box;
+  hex.replace(hex.find("count=\"12\""), 10, "count=\"0xc\"");
+  expectRefused("hex_count.dae", hex, "not a plain decimal number");
+  std::string utf16;
+  for (char c : box) (utf16 += c) += '\0';
+  expectRefused("utf16.dae", utf16, "byte 0x00");
+  // Tabs, line ends and a sign in a <p> list still read as before.
+  const std::string plain = edited("\r\n\t+");
+  writeText(file("plain.dae"), plain);
+  expectBox(loadMeshHull(file("plain.dae"), Vector3d::Ones()), kLoM, kHiM, kFloatTol);
+}
+
 TEST_F(MeshHullTest, EveryNodeInstanceOfAMeshIsLoaded) {
   // One geometry, two nodes 1 m apart along y: the hull spans both.
   writeText(file("two.dae"),
