@@ -28,10 +28,11 @@ int withBody(const Character& c, int link) {
 
 // The nearest common ancestor of two links (a link is its own ancestor).
 int commonAncestor(const UrdfModel& m, int a, int b) {
-  std::vector<int> up;
-  for (int l = a; l >= 0; l = m.links()[static_cast<std::size_t>(l)].parentLink) up.push_back(l);
+  std::vector<char> up(m.links().size(), 0);  // a and its ancestors: linear in depth
+  for (int l = a; l >= 0; l = m.links()[static_cast<std::size_t>(l)].parentLink)
+    up[static_cast<std::size_t>(l)] = 1;
   for (int l = b; l >= 0; l = m.links()[static_cast<std::size_t>(l)].parentLink)
-    if (std::find(up.begin(), up.end(), l) != up.end()) return l;
+    if (up[static_cast<std::size_t>(l)]) return l;
   return 0;
 }
 
@@ -134,6 +135,20 @@ ShoulderAnchors shoulderAnchorsOnLinks(const Character& c, const std::vector<std
   const UrdfModel& m = sk.model();
   const Frame f = characterFrame(sk);
   bool first = true;
+  // withBody of each link, remembered along the way up: many links under one body cost their depth once.
+  std::vector<int> bodyOf(m.links().size(), -2);  // -2: not known yet
+  auto withBodyOf = [&](int link) {
+    int l = link;
+    while (l >= 0 && bodyOf[static_cast<std::size_t>(l)] == -2 && c.bodies().bodyForLink(l) == nullptr)
+      l = m.links()[static_cast<std::size_t>(l)].parentLink;
+    const int found = l < 0                                       ? -1
+                      : bodyOf[static_cast<std::size_t>(l)] == -2 ? l
+                                                                  : bodyOf[static_cast<std::size_t>(l)];
+    for (int k = link; k != l; k = m.links()[static_cast<std::size_t>(k)].parentLink)
+      bodyOf[static_cast<std::size_t>(k)] = found;
+    if (l >= 0) bodyOf[static_cast<std::size_t>(l)] = found;
+    return found;
+  };
   for (const std::string& name : links) {
     const int link = m.findLink(name);
     if (link < 0) {
@@ -143,7 +158,7 @@ ShoulderAnchors shoulderAnchorsOnLinks(const Character& c, const std::vector<std
                                "unknown link \"" + name + "\" (the model's links: " + known + ")");
       return a;
     }
-    if (withBody(c, link) < 0) {
+    if (withBodyOf(link) < 0) {
       a.status = Status::error(
           ErrorCode::InvalidArgument,
           "link \"" + name + "\" and its ancestors have no collision shape, so no body to pin to");
@@ -152,11 +167,11 @@ ShoulderAnchors shoulderAnchorsOnLinks(const Character& c, const std::vector<std
     const Eigen::Vector3d p = f.local(sk.linkPose(link).translation());
     if (first || p.x() < a.left.x()) {
       a.left = p;
-      a.leftLink = withBody(c, link);
+      a.leftLink = withBodyOf(link);
     }
     if (first || p.x() > a.right.x()) {
       a.right = p;
-      a.rightLink = withBody(c, link);
+      a.rightLink = withBodyOf(link);
     }
     first = false;
   }

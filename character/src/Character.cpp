@@ -7,6 +7,8 @@
 #include <charconv>
 #include <cmath>
 #include <sstream>
+#include <unordered_set>
+#include <vector>
 
 namespace cape::character {
 
@@ -33,6 +35,7 @@ std::string movableJoints(const UrdfModel& model) {
 Status parsePose(const std::string& text, JointPose& out) {
   out.clear();
   JointPose pose;
+  std::unordered_set<std::string> given;  // the names so far: linear in the entries
   if (trim(text).empty()) return Status::success();
   std::size_t start = 0;
   for (int entry = 1;; ++entry) {
@@ -55,10 +58,7 @@ Status parsePose(const std::string& text, JointPose& out) {
     const std::from_chars_result r = std::from_chars(value.data(), end, q);
     if (r.ec != std::errc() || r.ptr != end) return fail("'" + value + "' is not a number");
     if (!std::isfinite(q)) return fail("the value must be finite");
-    for (const auto& [known, unused] : pose) {
-      (void)unused;
-      if (known == name) return fail("joint '" + name + "' is given twice");
-    }
+    if (!given.insert(name).second) return fail("joint '" + name + "' is given twice");
     pose.emplace_back(name, q);
     if (comma == std::string::npos) break;
     start = comma + 1;
@@ -100,6 +100,7 @@ Character::Character(const UrdfModelPtr& model, const Gait& gait, const Characte
 
 Status Character::applyPose() {
   const UrdfModel& model = skeleton_.model();
+  std::vector<char> posed(model.joints().size(), 0);  // joints given so far: linear in the entries
   for (const auto& [name, value] : settings_.pose) {
     const int j = model.findJoint(name);
     if (j < 0) {
@@ -118,12 +119,10 @@ Status Character::applyPose() {
       return Status::error(ErrorCode::InvalidArgument,
                            "CharacterSettings::pose: joint '" + name + "': the value is not finite");
     }
-    for (const auto& [done, unused] : pose_) {
-      (void)unused;
-      if (done == j)
-        return Status::error(ErrorCode::InvalidArgument,
-                             "CharacterSettings::pose: joint '" + name + "' is given twice");
-    }
+    if (posed[static_cast<std::size_t>(j)])
+      return Status::error(ErrorCode::InvalidArgument,
+                           "CharacterSettings::pose: joint '" + name + "' is given twice");
+    posed[static_cast<std::size_t>(j)] = 1;
     const double q = skeleton_.clampToLimits(j, value);
     if (q != value) {
       std::ostringstream msg;

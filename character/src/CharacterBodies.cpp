@@ -3,6 +3,7 @@
 
 #include <cassert>
 #include <cmath>
+#include <vector>
 
 namespace cape::character {
 
@@ -42,6 +43,31 @@ std::unique_ptr<btCollisionShape> makeShape(const ShapeDesc& s) {
     }
   }
   return nullptr;
+}
+
+// The order in which `count` bodies go into the world. Bullet's btDbvt inserts a leaf next to the nearest one
+// without rebalancing, so links added in order along a chain make a tree as deep as the chain: adding
+// 10,000 links took seconds, and every later update of a body's bounds walks that depth. Up to
+// kLinkOrderBodies bodies keep link order, so that every ordinary model's world (and simulation) stays as it
+// was to the bit; beyond, the bit-reversed order of the link indices spreads each chain over the whole tree
+// (depth about log2 of the count).
+constexpr std::size_t kLinkOrderBodies = 1024;
+
+std::vector<std::size_t> worldOrder(std::size_t count) {
+  std::vector<std::size_t> order;
+  order.reserve(count);
+  if (count <= kLinkOrderBodies) {
+    for (std::size_t k = 0; k < count; ++k) order.push_back(k);
+    return order;
+  }
+  int bits = 0;
+  while ((std::size_t(1) << bits) < count) ++bits;
+  for (std::size_t i = 0; i < (std::size_t(1) << bits); ++i) {
+    std::size_t r = 0;
+    for (int b = 0; b < bits; ++b) r |= ((i >> b) & 1u) << (bits - 1 - b);
+    if (r < count) order.push_back(r);
+  }
+  return order;
 }
 
 }  // namespace
@@ -95,10 +121,12 @@ CharacterBodies::CharacterBodies(btDynamicsWorld& world, const Skeleton& skeleto
     body->setUserPointer(lb.tag.get());
     body->setUserIndex(l);
 
-    world.addRigidBody(body, settings.group, settings.mask);
     bodyList_.push_back(body);
     linkOfObject_[body] = l;
   }
+  // Into the world in link order, or for a large model in bit-reversed link order (see worldOrder).
+  for (std::size_t k : worldOrder(bodyList_.size()))
+    world.addRigidBody(bodyList_[k], settings.group, settings.mask);
 }
 
 CharacterBodies::~CharacterBodies() {

@@ -272,18 +272,14 @@ bool namesPitch(const std::string& name) {
   return saysPitch(lower(name)) || tokenInfo(name).pitch;
 }
 
-// Links in the subtree under (and including) `link`.
+// Links in the subtree under (and including) `link`, in link order (parents before children). Walked down the
+// child joints, so that it costs the subtree's size (times its log for the sort), not the model's.
 std::vector<int> subtree(const UrdfModel& m, int link) {
-  std::vector<char> in(m.links().size(), 0);
-  in[static_cast<std::size_t>(link)] = 1;
   std::vector<int> out{link};
-  for (std::size_t l = static_cast<std::size_t>(link) + 1; l < m.links().size(); ++l) {
-    const int p = m.links()[l].parentLink;
-    if (p >= 0 && in[static_cast<std::size_t>(p)]) {
-      in[l] = 1;
-      out.push_back(static_cast<int>(l));
-    }
-  }
+  for (std::size_t k = 0; k < out.size(); ++k)
+    for (int j : m.links()[static_cast<std::size_t>(out[k])].childJoints)
+      out.push_back(m.joints()[static_cast<std::size_t>(j)].childLink);
+  std::sort(out.begin(), out.end());
   return out;
 }
 
@@ -415,17 +411,24 @@ std::vector<int> shoulderChain(const UrdfModel& m, int side) {
   const int top = *std::min_element(chain.begin(), chain.end(), [&](int a, int b) {
     return joints[static_cast<std::size_t>(a)].parentLink < joints[static_cast<std::size_t>(b)].parentLink;
   });
-  const std::vector<int> below = subtree(m, joints[static_cast<std::size_t>(top)].childLink);
-  auto inBelow = [&](int link) { return std::find(below.begin(), below.end(), link) != below.end(); };
+  std::vector<char> below(m.links().size(), 0), inChain(joints.size(), 0), walked(m.links().size(), 0);
+  for (int l : subtree(m, joints[static_cast<std::size_t>(top)].childLink))
+    below[static_cast<std::size_t>(l)] = 1;
+  for (int j : chain) inChain[static_cast<std::size_t>(j)] = 1;
   for (int e : elbows) {
-    // Walk up from the elbow to the top shoulder joint, collecting the joints on the way.
+    // Walk up from the elbow to the top shoulder joint, collecting the joints on the way. A link walked from
+    // an earlier elbow has had its way up collected already: each link is walked once.
     int link = joints[static_cast<std::size_t>(e)].parentLink;
-    while (link >= 0 && inBelow(link) && link != joints[static_cast<std::size_t>(top)].childLink) {
+    while (link >= 0 && below[static_cast<std::size_t>(link)] &&
+           link != joints[static_cast<std::size_t>(top)].childLink &&
+           !walked[static_cast<std::size_t>(link)]) {
+      walked[static_cast<std::size_t>(link)] = 1;
       const int j = m.links()[static_cast<std::size_t>(link)].parentJoint;
       if (j < 0) break;
-      if (isRotary(joints[static_cast<std::size_t>(j)]) &&
-          std::find(chain.begin(), chain.end(), j) == chain.end())
+      if (isRotary(joints[static_cast<std::size_t>(j)]) && !inChain[static_cast<std::size_t>(j)]) {
         chain.push_back(j);
+        inChain[static_cast<std::size_t>(j)] = 1;
+      }
       link = m.links()[static_cast<std::size_t>(link)].parentLink;
     }
   }
@@ -487,11 +490,13 @@ struct Limbs {
   int pelvis = -1;                 // where the legs meet; -1 when no legs were found
 };
 
+// The lowest link that is `a` or an ancestor of it and `b` or an ancestor of it; -1 if none. Linear in depth.
 int commonAncestor(const UrdfModel& m, int a, int b) {
-  std::vector<int> up;
-  for (int l = a; l >= 0; l = m.links()[static_cast<std::size_t>(l)].parentLink) up.push_back(l);
+  std::vector<char> up(m.links().size(), 0);
+  for (int l = a; l >= 0; l = m.links()[static_cast<std::size_t>(l)].parentLink)
+    up[static_cast<std::size_t>(l)] = 1;
   for (int l = b; l >= 0; l = m.links()[static_cast<std::size_t>(l)].parentLink)
-    if (std::find(up.begin(), up.end(), l) != up.end()) return l;
+    if (up[static_cast<std::size_t>(l)]) return l;
   return -1;
 }
 
@@ -708,7 +713,10 @@ double bendSign(const UrdfModelPtr& model, int joint, double qPlus, double qMinu
   while (above >= 0 && (pointInRoot(s.linkPose(above).translation()) - at).norm() < 0.02)
     above = model->links()[static_cast<std::size_t>(above)].parentLink;
   if (above < 0) return 0.0;
-  const auto [link, local] = farthestBeyond(s, joint);
+  // Plain variables, not structured bindings: a lambda may capture those only from C++20 (clang 14 refuses).
+  const std::pair<int, Eigen::Vector3d> farthest = farthestBeyond(s, joint);
+  const int link = farthest.first;
+  const Eigen::Vector3d local = farthest.second;
   auto place = [&](double q, Eigen::Vector3d& end, Eigen::Vector3d& top) {
     pose(joint, q);
     end = pointInRoot(s.linkPose(link) * local);
@@ -877,14 +885,16 @@ JointMapping JointMapping::build(const UrdfModelPtr& model, bool byName, bool by
         for (int k = from; k < to && e.joint < 0 && length > 1e-6; ++k) {
           const int j = chain[static_cast<std::size_t>(k)];
           if (used(j)) continue;
+          // The cheap tests first: what lies beyond a joint costs its subtree.
           const Eigen::Vector3d at = jointOrigin(held, j);
+          if ((at - top).norm() < 0.2 * length) continue;
           Eigen::Vector3d in = Eigen::Vector3d::Zero();
           for (int b = k - 1; b >= 0 && in.norm() < 0.01; --b)
             in = at - jointOrigin(held, chain[static_cast<std::size_t>(b)]);
-          const Eigen::Vector3d out = armBeyond(held, j), axis = axisInRoot(held, j).normalized();
-          if ((at - top).norm() < 0.2 * length || in.norm() < 0.01 || out.norm() < 0.2 * length) continue;
-          if (std::abs(axis.dot(in.normalized())) > 0.5 || std::abs(axis.dot(out.normalized())) > 0.5)
-            continue;
+          const Eigen::Vector3d axis = axisInRoot(held, j).normalized();
+          if (in.norm() < 0.01 || std::abs(axis.dot(in.normalized())) > 0.5) continue;
+          const Eigen::Vector3d out = armBeyond(held, j);
+          if (out.norm() < 0.2 * length || std::abs(axis.dot(out.normalized())) > 0.5) continue;
           e.joint = j;
           from = k + 1;
           how = limbName(limb, leg, side) +
