@@ -102,6 +102,8 @@ class SimpleScene {
   /// Advances one frame of dt seconds: moves the body and the pins, then steps the cape.
   void advanceFrame(float dt = 1.0f / 60.0f);
   double time() const { return time_; }
+  /// The scene it was made for (its motion and the cape's settings follow from it).
+  SceneKind kind() const { return kind_; }
   const MotionDesc& motion() const { return motion_; }
   Cape& cape() { return cape_; }
   const Cape& cape() const { return cape_; }
