@@ -558,6 +558,36 @@ bool elementNamed(const std::string& text, std::size_t at, const char* name) {
   return next == '>' || next == '/' || isXmlSpace(next);
 }
 
+// The value of attribute `name` in the start tag text[at .. close], false when it has none.
+bool attributeOf(const std::string& text, std::size_t at, std::size_t close, const std::string& name,
+                 std::string& value) {
+  for (std::size_t i = text.find(name, at); i != std::string::npos && i < close; i = text.find(name, i + 1)) {
+    if (!isXmlSpace(text[i - 1])) continue;
+    std::size_t j = i + name.size();
+    while (j < close && isXmlSpace(text[j])) ++j;
+    if (j >= close || text[j] != '=') continue;
+    ++j;
+    while (j < close && isXmlSpace(text[j])) ++j;
+    if (j >= close || (text[j] != '"' && text[j] != '\'')) continue;
+    const std::size_t end = text.find(text[j], j + 1);
+    if (end == std::string::npos || end > close) return false;
+    value = text.substr(j + 1, end - j - 1);
+    return true;
+  }
+  return false;
+}
+
+// A plain decimal number (white space around it allowed), capped just above `cap`; false for anything else.
+bool plainNumber(const std::string& s, std::uintmax_t cap, std::uintmax_t& value) {
+  std::size_t i = 0, digits = 0;
+  while (i < s.size() && isXmlSpace(s[i])) ++i;
+  value = 0;
+  for (; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i, ++digits)
+    if (value <= cap) value = 10 * value + static_cast<std::uintmax_t>(s[i] - '0');
+  while (i < s.size() && isXmlSpace(s[i])) ++i;
+  return digits > 0 && i == s.size();
+}
+
 Status checkColladaText(const std::string& path, const std::string& text) {
   const auto refuse = [&](std::size_t at, const std::string& what) {
     return invalidModel(path,
@@ -626,6 +656,43 @@ Status checkColladaText(const std::string& path, const std::string& text) {
     if (!isP && sum > text.size())
       return refuse(close + 1, "a <vcount> list whose corners outnumber the file's bytes");
     at = i;
+  }
+  // Arrays and the accessors that read them: assimp 5.2 reads an array's `count` values (none without the
+  // attribute) and then indexes it through an accessor without checking that the accessor fits (a float_array
+  // without its count segfaults). So every array has a count, and every accessor of a known array keeps
+  // offset + count * stride within it.
+  std::map<std::string, std::uintmax_t> arrays;
+  for (const char* name : {"float_array", "int_array", "bool_array", "Name_array", "IDREF_array"}) {
+    for (std::size_t at = text.find(std::string("<") + name); at != std::string::npos;
+         at = text.find(std::string("<") + name, at + 1)) {
+      if (!elementNamed(text, at, name)) continue;
+      const std::size_t close = text.find('>', at);
+      if (close == std::string::npos) return refuse(at, std::string("an unclosed <") + name + "> tag");
+      std::string id, count;
+      std::uintmax_t n = 0;
+      if (!attributeOf(text, at, close, "count", count) || !plainNumber(count, text.size(), n))
+        return refuse(at, std::string("a <") + name + "> without a plain decimal count");
+      if (attributeOf(text, at, close, "id", id)) arrays[id] = n;
+    }
+  }
+  for (std::size_t at = text.find("<accessor"); at != std::string::npos;
+       at = text.find("<accessor", at + 1)) {
+    if (!elementNamed(text, at, "accessor")) continue;
+    const std::size_t close = text.find('>', at);
+    if (close == std::string::npos) return refuse(at, "an unclosed <accessor> tag");
+    std::string source, attr;
+    if (!attributeOf(text, at, close, "source", source) || source.empty() || source[0] != '#') continue;
+    const auto array = arrays.find(source.substr(1));
+    if (array == arrays.end()) continue;  // assimp refuses a reference it cannot resolve
+    std::uintmax_t count = 0, stride = 1, offset = 0;
+    const std::uintmax_t cap = text.size();
+    if ((attributeOf(text, at, close, "count", attr) && !plainNumber(attr, cap, count)) ||
+        (attributeOf(text, at, close, "stride", attr) && !plainNumber(attr, cap, stride)) ||
+        (attributeOf(text, at, close, "offset", attr) && !plainNumber(attr, cap, offset)))
+      return refuse(at, "an <accessor> whose count, stride or offset is not a plain decimal number");
+    const std::uintmax_t size = array->second;  // <= the file's size, so the product below cannot overflow
+    if (count > 0 && (count > size || stride > size || offset > size || offset + count * stride > size))
+      return refuse(at, "an <accessor> reaching past the end of its array '" + array->first + "'");
   }
   return Status::success();
 }

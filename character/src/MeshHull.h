@@ -72,8 +72,8 @@ Status resolveMeshUri(const std::string& uri, const std::string& baseDir,
 /// - COLLADA (what assimp may read as COLLADA: .dae, .zae, .xml, or "<collada" near the start) is checked
 ///   before assimp reads it, and refused (InvalidModel naming the byte) where Debian's assimp 5.2 would loop
 ///   or allocate without bound: a <p> or <vcount> list holding anything but digits, signs and white space, a
-///   count attribute that is not a decimal number or exceeds the file's size, a control byte (UTF-16/32
-///   text or a zip archive).
+///   count attribute that is not a decimal number or exceeds the file's size, an array without a count, an
+///   accessor reaching past its array, a control byte (UTF-16/32 text or a zip archive).
 /// - A flat mesh (every vertex within 1e-5 of its size from one plane: a plate, a single triangle) is a
 ///   legitimate collision mesh: its vertices are moved off the plane by +-h along the plane's normal, h =
 ///   0.5 mm but at least 1e-4 and at most 1e-2 of the mesh's size, so the hull is a thin solid slab.

@@ -372,6 +372,14 @@ TEST_F(MeshHullTest, ColladaThatAssimpWouldLoopOnIsRefusedAndPlainIndexListsStil
   std::string hex = box;
   hex.replace(hex.find("count=\"12\""), 10, "count=\"0xc\"");
   expectRefused("hex_count.dae", hex, "not a plain decimal number");
+  // An array without its count (assimp reads no value, then indexes it: a segfault) and an accessor reaching
+  // past its array's end.
+  std::string uncounted = box;
+  uncounted.replace(uncounted.find("count=\"24\""), 5, "coune");
+  expectRefused("uncounted.dae", uncounted, "without a plain decimal count");
+  std::string reaching = box;
+  reaching.replace(reaching.find("count=\"8\""), 9, "count=\"9\"");
+  expectRefused("reaching.dae", reaching, "reaching past the end of its array");
   std::string utf16;
   for (char c : box) (utf16 += c) += '\0';
   expectRefused("utf16.dae", utf16, "byte 0x00");
