@@ -8,7 +8,7 @@
 # and keeps what it learns in BUILD/corpus/run/TARGET/ (a later run goes on from there). Anything found
 # (a crash, an input over 2 s, a leak, a sanitizer report, over 2 GB) stops the run with libFuzzer's non-zero
 # status and is written to BUILD/artifacts/TARGET/. Environment: CAPE_FUZZ_BUILD (the build folder,
-# default build-fuzz), CAPE_FUZZ_CXX (default clang++-16 when installed, else clang++), CAPE_FUZZ_SKIP_BUILD=1
+# default build-fuzz), CAPE_FUZZ_CXX (default clang++, Debian 12's clang 14), CAPE_FUZZ_SKIP_BUILD=1
 # (use the build as it is, for runs side by side).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -18,10 +18,7 @@ usage() { sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 [ $# -ge 1 ] || usage
 
 if [ "${CAPE_FUZZ_SKIP_BUILD:-0}" != 1 ]; then
-  cxx="${CAPE_FUZZ_CXX:-}"
-  if [ -z "$cxx" ]; then
-    if command -v clang++-16 >/dev/null; then cxx=clang++-16; else cxx=clang++; fi
-  fi
+  cxx="${CAPE_FUZZ_CXX:-clang++}"
   cmake -S "$root" -B "$build" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCAPE_FUZZ=ON \
     -DCAPE_BUILD_BENCHMARKS=OFF -DCAPE_BUILD_DEMOS=OFF >/dev/null
   cmake --build "$build" -j"$(nproc)" --target cape_fuzz_all
