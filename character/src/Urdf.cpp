@@ -479,10 +479,14 @@ struct UrdfModelBuilder {
     joint.origin = toIsometry(src.parent_to_joint_origin_transform);
     const Eigen::Vector3d axis(src.axis.x, src.axis.y, src.axis.z);
     if (joint.isMovable()) {
-      if (!axis.allFinite() || axis.norm() < 1e-9) {
-        return Status::error(ErrorCode::InvalidModel, "joint '" + src.name + "' has a zero axis");
+      // Scaled by its largest component first: the square of a component beyond 1e154 overflows the
+      // norm to inf, and the axis "normalised" by it to zero (found by the urdf fuzz target).
+      const double largest = axis.cwiseAbs().maxCoeff();
+      if (!std::isfinite(largest) || !((axis / std::max(largest, 1e-300)).norm() * largest >= 1e-9)) {
+        return Status::error(ErrorCode::InvalidModel,
+                             "joint '" + src.name + "' has a zero or not finite axis");
       }
-      joint.axis = axis.normalized();
+      joint.axis = std::isfinite(axis.norm()) ? axis.normalized() : (axis / largest).normalized();
     }
     if (src.limits) {
       joint.maxVelocity = src.limits->velocity;

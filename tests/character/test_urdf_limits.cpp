@@ -400,3 +400,20 @@ TEST(UrdfLimits, LengthsBeyondAnyRobotAreRefusedNamingTheLimit) {
   bad.maxLength = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(UrdfModel::fromString(humanoid, withLimits(bad)).status.code(), ErrorCode::InvalidArgument);
 }
+
+TEST(UrdfLimits, AJointAxisWhoseSquareOverflowsIsStillMadeAUnitVector) {
+  // <axis xyz="1e300 -1 0">: its norm overflowed to inf and the axis came out (0, -0, 0), not a unit vector
+  // (found by the urdf fuzz target; regressions/urdf/axis_1e300_not_unit.urdf).
+  std::string text = UrdfModel::humanoidUrdf();
+  const std::string joint = "name=\"right_hip_pitch\"";
+  const std::size_t at = text.find("<axis xyz=\"", text.find(joint));
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, text.find("/>", at) - at, "<axis xyz=\"1e300 -1 0\"");
+  const UrdfLoadResult r = UrdfModel::fromString(text);
+  ASSERT_TRUE(r.ok()) << r.status.message();
+  const JointDesc& j = r.model->joints()[static_cast<std::size_t>(r.model->findJoint("right_hip_pitch"))];
+  EXPECT_NEAR(j.axis.norm(), 1.0, 1e-12);
+  EXPECT_NEAR(j.axis.x(), 1.0, 1e-12);
+  text.replace(text.find("<axis xyz=\"1e300 -1 0\""), 22, "<axis xyz=\"1e-300 0 0\"");
+  EXPECT_EQ(UrdfModel::fromString(text).status.code(), ErrorCode::InvalidModel);
+}
