@@ -43,27 +43,6 @@ std::string normalised(const std::string& s) {
   return out;
 }
 
-// The five entities XML predefines; URDF file names may hold '&amp;'.
-std::string expandEntities(const std::string& s) {
-  static const std::pair<const char*, char> entities[] = {
-      {"&amp;", '&'}, {"&lt;", '<'}, {"&gt;", '>'}, {"&quot;", '"'}, {"&apos;", '\''}};
-  std::string out;
-  for (std::size_t i = 0; i < s.size();) {
-    bool matched = false;
-    for (const auto& [name, c] : entities) {
-      const std::size_t n = std::char_traits<char>::length(name);
-      if (s.compare(i, n, name) == 0) {
-        out += c;
-        i += n;
-        matched = true;
-        break;
-      }
-    }
-    if (!matched) out += s[i++];
-  }
-  return out;
-}
-
 // What textForUrdfdom gives urdfdom for a value: runs of white space collapsed and none at the ends when the
 // value has any around it or any tab or line break (urdfdom takes runs of spaces between numbers).
 bool untidy(const std::string& value) {
@@ -326,7 +305,10 @@ class GeometryReader {
       warn(label, "is a mesh without a filename");
       return false;
     }
-    const std::string uri = expandEntities(trim(*file));
+    // Read as TinyXML reads attribute values (entities and character references); a reference that is no
+    // character stays as written, and the file is then not found.
+    std::string uri;
+    if (!expandReferences(trim(*file), uri)) uri = trim(*file);
     Eigen::Vector3d scale = Eigen::Vector3d::Ones();
     if (const std::string* s = e.attribute("scale")) {
       if (!parseNumbers(*s, 3, true, scale) || !(scale.array() > 0.0).all()) {
