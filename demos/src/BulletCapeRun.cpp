@@ -1,23 +1,53 @@
 // Our cape on the scene's Bullet world: one CapeAction per character, stepped together by a CapeGroup (on
-// --threads workers) inside stepSimulation.
+// --threads workers) inside stepSimulation. The cape time of a frame is the wall time of the group's
+// updateAction calls in it (every cape's prepare and advance, on however many workers), timed from outside;
+// the rest of stepSimulation is Bullet's own.
 #include "BulletScene.h"
 
 #include "cape/bullet/CapeAction.h"
 #include "cape/bullet/CapeGroup.h"
 #include "cape/bullet/Convert.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 
 namespace cape::demo {
 
 namespace {
 
+/// The group as the world sees it: each internal step's updateAction passed on and timed, wall clock.
+class TimedGroup final : public btActionInterface {
+ public:
+  explicit TimedGroup(bullet::CapeGroup& group) : group_(group) {}
+  void updateAction(btCollisionWorld* world, btScalar dt) override {
+    const auto start = std::chrono::steady_clock::now();
+    group_.updateAction(world, dt);
+    microseconds_ +=
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  }
+  void debugDraw(btIDebugDraw* drawer) override { group_.debugDraw(drawer); }
+  /// The wall time of the updateAction calls since the last call of this function, µs.
+  double takeMicroseconds() {
+    const double t = microseconds_;
+    microseconds_ = 0.0;
+    return t;
+  }
+
+ private:
+  bullet::CapeGroup& group_;
+  double microseconds_ = 0.0;
+};
+
 class BulletCapeRun final : public SceneRun {
  public:
   BulletCapeRun(std::unique_ptr<BulletScene> scene, int threads)
-      : scene_(std::move(scene)), group_(std::make_unique<bullet::CapeGroup>(threads)) {}
+      : scene_(std::move(scene)),
+        group_(std::make_unique<bullet::CapeGroup>(threads)),
+        timed_(std::make_unique<TimedGroup>(*group_)) {}
   ~BulletCapeRun() override {
-    scene_->world().removeAction(group_.get());
+    scene_->world().removeAction(timed_.get());
+    timed_.reset();
     group_.reset();
     capes_.clear();
   }
@@ -34,12 +64,16 @@ class BulletCapeRun final : public SceneRun {
         error = cape->cape().status().message();
         return false;
       }
-      cape->relocate(scene_->origin());  // placed relative to the scene's origin: moved there exactly
+      // Placed relative to the scene's origin, in a frame at the grid point nearest that placement (zero
+      // near the origin): moved there exactly, the frame kept at that grid point from the scene's origin. A
+      // crowd's capes more than 8 m out (half CapeActionSettings::frameSpacing) keep frames of their own,
+      // which relocating to the origin itself would have dropped, shifting the cape 16 m from its pins.
+      cape->relocate(scene_->origin() + cape->frameOrigin());
       for (const PinSpec& p : scene_->pins(k)) cape->attach(p.particle, p.body, p.localPivot);
       group_->add(cape.get());
       capes_.push_back(std::move(cape));
     }
-    scene_->world().addAction(group_.get());
+    scene_->world().addAction(timed_.get());
     return true;
   }
 
@@ -47,8 +81,8 @@ class BulletCapeRun final : public SceneRun {
   void advanceFrame() override {
     ++frame_;
     frameUs_ = scene_->stepFrame(frame_ / 60.0);
-    capeUs_ = 0.0;
-    for (auto& c : capes_) capeUs_ += c->takeAccumulatedMicroseconds();
+    capeUs_ = std::min(timed_->takeMicroseconds(), frameUs_);
+    for (auto& c : capes_) c->takeAccumulatedMicroseconds();  // each cape's own work: not needed here
     guardTotals_.resize(capes_.size(), 0);
     guardLastFrame_.resize(capes_.size(), 0);
     for (std::size_t k = 0; k < capes_.size(); ++k) {
@@ -57,8 +91,6 @@ class BulletCapeRun final : public SceneRun {
           static_cast<std::uint32_t>(std::min<std::uint64_t>(total - guardTotals_[k], 0xffffffffu));
       guardTotals_[k] = total;
     }
-    // With several workers the capes run at once: their summed work overstates the wall time they took.
-    if (group_->threadCount() > 1) capeUs_ = std::min(capeUs_, frameUs_);
   }
   const Cape& cape(int k) const override { return capes_[static_cast<std::size_t>(k)]->cape(); }
   std::vector<Collider> bodyColliders(int k) const override {
@@ -75,6 +107,7 @@ class BulletCapeRun final : public SceneRun {
   }
   double lastFrameTimeUs() const override { return frameUs_; }
   double lastCapeTimeUs() const override { return capeUs_; }
+  int worldObjectCount() const override { return scene_->world().getNumCollisionObjects(); }
   std::string describe() const override { return scene_->describe(); }
   Vec3 up() const override { return scene_->up(); }
   CapeSize capeSize() const override { return scene_->capeSize(); }
@@ -82,6 +115,7 @@ class BulletCapeRun final : public SceneRun {
  private:
   std::unique_ptr<BulletScene> scene_;
   std::unique_ptr<bullet::CapeGroup> group_;
+  std::unique_ptr<TimedGroup> timed_;  ///< the group in the world, timed
   std::vector<std::unique_ptr<bullet::CapeAction>> capes_;
   std::vector<std::uint64_t> guardTotals_;     ///< each cape's Cape::guard().total after the last frame
   std::vector<std::uint32_t> guardLastFrame_;  ///< what the guard restored in the last frame

@@ -28,9 +28,21 @@ Pose poseOf(const Eigen::Isometry3d& t) {
   return p;
 }
 
+// docs/SCENES.md's crowd: a square grid 2 m apart, rows of ceil(sqrt(count)) characters side by side along
+// X, one row behind another along +Z (they walk towards -Z), centred on the origin. One character stands on
+// it, two side by side as they always did.
+int crowdColumns(int count) {
+  int columns = 1;
+  while (columns * columns < count) ++columns;
+  return columns;
+}
+
 Vec3 crowdOffset(int k, int count) {
-  // Side by side, 2 m apart along X, centred on the origin.
-  return Vec3(2.0f * (static_cast<float>(k) - 0.5f * static_cast<float>(count - 1)), 0.0f, 0.0f);
+  const int columns = crowdColumns(count);
+  const int rows = (count + columns - 1) / columns;
+  const int column = k % columns, row = k / columns;
+  return Vec3(2.0f * (static_cast<float>(column) - 0.5f * static_cast<float>(columns - 1)), 0.0f,
+              2.0f * (static_cast<float>(row) - 0.5f * static_cast<float>(rows - 1)));
 }
 
 // The core's hull of a character's convex-hull shape (vertices and planes in the shape frame).
@@ -203,8 +215,14 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
     return false;
   }
   c->urdf = std::move(made.character);
-  for (const character::WorldShape& w : c->urdf->skeleton().worldShapes())
-    c->hulls.push_back(w.shape->type == character::ShapeType::ConvexHull ? hullOf(*w.shape) : nullptr);
+  // Every character is the same model at the same scale: the first one's hulls serve the crowd.
+  const std::vector<character::WorldShape> shapes = c->urdf->skeleton().worldShapes();
+  if (!first && characters_.front()->hulls.size() == shapes.size()) {
+    c->hulls = characters_.front()->hulls;
+  } else {
+    for (const character::WorldShape& w : shapes)
+      c->hulls.push_back(w.shape->type == character::ShapeType::ConvexHull ? hullOf(*w.shape) : nullptr);
+  }
   if (first) {
     for (const std::string& w : c->urdf->warnings())
       if (std::find(warnings_.begin(), warnings_.end(), w) == warnings_.end()) warnings_.push_back(w);

@@ -119,8 +119,8 @@ void writeObj(const fs::path& file, const CapeMesh& mesh, std::size_t n) {
   std::fclose(f);
 }
 
-RunWriter::RunWriter(const fs::path& dir, bool writeFrames, int characters)
-    : dir_(dir), writeFrames_(writeFrames), characters_(characters) {
+RunWriter::RunWriter(const fs::path& dir, bool writeFrames, int characters, bool writeColliders)
+    : dir_(dir), writeFrames_(writeFrames), characters_(characters), writeColliders_(writeColliders) {
   std::error_code ec;
   fs::create_directories(dir_, ec);
   if (ec) throw std::runtime_error("cannot create output folder " + dir_.string() + ": " + ec.message());
@@ -134,8 +134,8 @@ RunWriter::RunWriter(const fs::path& dir, bool writeFrames, int characters)
     if (ec) throw std::runtime_error("cannot create " + (dir_ / "frames").string() + ": " + ec.message());
   }
   csv_.open(dir_ / "metrics.csv");
-  jsonl_.open(dir_ / "colliders.jsonl");
-  if (!csv_ || !jsonl_) throw std::runtime_error("cannot write into " + dir_.string());
+  if (writeColliders_) jsonl_.open(dir_ / "colliders.jsonl");
+  if (!csv_ || (writeColliders_ && !jsonl_)) throw std::runtime_error("cannot write into " + dir_.string());
   csv_ << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_"
           "intersections,"
           "pin_error_m,mean_speed_mps,blow_up,guard_restored\n";
@@ -164,6 +164,7 @@ void RunWriter::capeMesh(std::int64_t frame, int character, const Fabric& fabric
 }
 
 void RunWriter::colliders(std::int64_t frame, const std::vector<Collider>& colliders) {
+  if (!writeColliders_) return;
   json j;
   j["frame"] = frame;
   j["colliders"] = json::array();
@@ -181,6 +182,7 @@ void FrameTimings::add(const FrameRow& row) {
   if (row.frame <= 10) return;  // frames 11..end
   frameTimeUs_.add(row.frameTimeUs);
   capeTimeUs_.add(row.capeTimeUs);
+  bulletTimeUs_.add(std::max(0.0, row.frameTimeUs - row.capeTimeUs));
 }
 
 json summaryFigures(const FrameTimings& timings, const RunSummary& q) {
@@ -203,6 +205,15 @@ json summaryFigures(const FrameTimings& timings, const RunSummary& q) {
   j["blow_up"] = q.blowUp;
   j["guard_restored_particles"] = q.guardRestored;
   j["frames_guard_restored"] = q.framesGuardRestored;
+  return j;
+}
+
+json frameShareFigures(const FrameTimings& timings, int capes) {
+  json j;
+  j["bullet_time_us_median"] = timings.bulletTimeUs().percentile(50.0);
+  j["bullet_time_us_p95"] = timings.bulletTimeUs().percentile(95.0);
+  // The median of the frames' cape time / K is the median cape time / K.
+  j["cape_time_per_cape_us_median"] = timings.capeTimeUs().percentile(50.0) / std::max(1, capes);
   return j;
 }
 

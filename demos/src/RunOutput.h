@@ -2,7 +2,8 @@
 //   metrics.csv      one row per frame with every metric of docs/SCENES.md
 //   summary.json     scene, settings, grid and cape dimensions, summary figures
 //   frames/NNNNN.obj the cape mesh of each kept frame (frames/kK/NNNNN.obj per character in a crowd)
-//   colliders.jsonl  one JSON object per kept frame with every body collider
+//   colliders.jsonl  one JSON object per kept frame with every body collider (not in a crowd with
+//                    --no-frames: nothing per character is written then but the summary)
 // and how a demo takes its --out folder (checkOutFolder, prepareOutFolder).
 #pragma once
 
@@ -24,7 +25,7 @@ struct FrameRow {
   std::int64_t frame = 0;
   double time = 0.0;         ///< s, at the end of the frame
   double frameTimeUs = 0.0;  ///< wall time of the whole frame step
-  double capeTimeUs = 0.0;   ///< the cape solver's share
+  double capeTimeUs = 0.0;   ///< the cape solver's share (the rest is Bullet's own)
   FrameMetrics metrics;
 };
 
@@ -39,11 +40,14 @@ void writeObj(const std::filesystem::path& file, const CapeMesh& mesh, std::size
 
 class RunWriter {
  public:
-  /// Creates the folder (and frames/ unless writeFrames is false). Throws std::runtime_error if it cannot.
-  RunWriter(const std::filesystem::path& dir, bool writeFrames, int characters);
+  /// Creates the folder (and frames/ unless writeFrames is false; colliders.jsonl unless writeColliders is
+  /// false). Throws std::runtime_error if it cannot.
+  RunWriter(const std::filesystem::path& dir, bool writeFrames, int characters, bool writeColliders = true);
   void frame(const FrameRow& row);
   void capeMesh(std::int64_t frame, int character, const Fabric& fabric, const Points& positions);
   void colliders(std::int64_t frame, const std::vector<Collider>& colliders);
+  bool writesFrames() const { return writeFrames_; }
+  bool writesColliders() const { return writeColliders_; }
   void summary(const nlohmann::json& summary);
   const std::filesystem::path& dir() const { return dir_; }
 
@@ -51,24 +55,31 @@ class RunWriter {
   std::filesystem::path dir_;
   bool writeFrames_;
   int characters_;
+  bool writeColliders_;
   std::ofstream csv_;
   std::ofstream jsonl_;
   CapeMesh mesh_;
 };
 
 /// The frame and cape times of a run over frames 11..end, as docs/SCENES.md defines them, in constant memory.
+/// Bullet's own share of a frame is its stepSimulation wall time less the cape time (never below 0).
 class FrameTimings {
  public:
   void add(const FrameRow& row);
   const PercentileEstimator& frameTimeUs() const { return frameTimeUs_; }
   const PercentileEstimator& capeTimeUs() const { return capeTimeUs_; }
+  const PercentileEstimator& bulletTimeUs() const { return bulletTimeUs_; }
 
  private:
-  PercentileEstimator frameTimeUs_, capeTimeUs_;
+  PercentileEstimator frameTimeUs_, capeTimeUs_, bulletTimeUs_;
 };
 
 /// Summary figures of a run: its timings' median and p95 and the quality summary.
 nlohmann::json summaryFigures(const FrameTimings& timings, const RunSummary& quality);
+
+/// How a cape_walk frame divides: Bullet's own share (bullet_time_us_median, _p95) and the cape time per
+/// cape (cape_time_per_cape_us_median: the median cape time over `capes`).
+nlohmann::json frameShareFigures(const FrameTimings& timings, int capes);
 
 /// Which demo's files an output folder holds.
 enum class RunFolderKind {

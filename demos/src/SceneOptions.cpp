@@ -22,8 +22,9 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
                  "simulated length, s, up to 24 h, rounded to whole 1/60 s frames (default: the scene's "
                  "own length)")
       ->transform(strictReal(kMinSeconds, kMaxSeconds));
-  app.add_option("--characters", cli.characters, "characters in the crowd scene")
-      ->transform(strictInteger(1, 64))
+  app.add_option("--characters", cli.characters,
+                 "characters in the crowd scene, on a square grid 2 m apart (rows of ceil(sqrt(K)))")
+      ->transform(strictInteger(1, kMaxCharacters))
       ->capture_default_str();
   app.add_flag("--simple-body", cli.simpleBody,
                "use the simple body of docs/SCENES.md instead of a URDF character");

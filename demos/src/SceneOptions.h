@@ -20,6 +20,7 @@ constexpr double kMaxOrigin = 1e7;            ///< |X|, |Y|, |Z| of --origin, m
 constexpr std::int64_t kMaxFrames = 5184000;  ///< 1/60 s frames in kMaxSeconds (--frames-every's bound)
 constexpr int kMinImageSide = 16;             ///< --render-size, px (each side even, for the H.264 video)
 constexpr int kMaxImageSide = 4096;
+constexpr int kMaxCharacters = 4096;  ///< --characters: the crowd's size, on a square grid 2 m apart
 
 struct SceneCli {
   std::string scene = "walk";

@@ -57,9 +57,12 @@ class SceneRun {
   virtual Eigen::Vector3d frameOffset(int character) const = 0;
   /// Particles the cape's numerical guard restored during the last frame (Cape::guard()).
   virtual std::uint32_t guardRestoredLastFrame(int character) const = 0;
-  /// Wall time of the last frame, and the cape solver's share of it, µs.
+  /// Wall time of the last frame's stepSimulation, and the capes' share of it (the wall time of their
+  /// updateAction calls, on however many workers), µs; the rest is Bullet's own.
   virtual double lastFrameTimeUs() const = 0;
   virtual double lastCapeTimeUs() const = 0;
+  /// Collision objects in the world (every character's bodies and the ground).
+  virtual int worldObjectCount() const = 0;
   /// A description for summary.json (body, URDF, attachment links, stepping).
   virtual std::string describe() const = 0;
   /// The world's up direction (the ground is the plane through the origin normal to it).

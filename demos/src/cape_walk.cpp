@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +24,9 @@ using namespace cape;
 using namespace cape::demo;
 
 namespace {
+
+/// --gltf keeps every frame of every cape in memory until the run ends: a crowd of at most this many.
+constexpr int kMaxGltfCharacters = 64;
 
 // A cape and its colliders moved from the cape's frame into the scene's (by SceneRun::frameOffset, in
 // double) and turned by `turn` (the identity, or a Z-up world into the Y-up scene frame for glTF and the
@@ -103,6 +107,13 @@ int main(int argc, char** argv) {
     return 1;
   }
   o.threads = threads;
+  if (!gltf.empty() && o.characters > kMaxGltfCharacters) {
+    std::fprintf(stderr,
+                 "cape_walk: --gltf keeps every frame of every cape in memory until the run ends: a crowd of "
+                 "at most %d characters (not %d)\n",
+                 kMaxGltfCharacters, o.characters);
+    return 1;
+  }
   const std::string& scene = sceneCli.scene;
   const std::string& attachment = sceneCli.attachment;
   const int size = sceneCli.size;
@@ -131,17 +142,26 @@ int main(int argc, char** argv) {
   }
   int renderWidth = 0, renderHeight = 0;
   parseImageSize(renderSize, kMinImageSide, kMaxImageSide, true, renderWidth, renderHeight);  // checked
+  const auto buildStart = std::chrono::steady_clock::now();
   std::unique_ptr<SceneRun> run = makeSceneRun(o, error);
   if (!run) {
     std::fprintf(stderr, "cape_walk: %s\n", error.c_str());
     return 1;
   }
+  const double buildSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - buildStart).count();
+  if (o.scene == SceneKind::Crowd)
+    std::printf("cape_walk: %d characters with their capes, %d Bullet collision objects, built in %.2f s\n",
+                run->characterCount(), run->worldObjectCount(), buildSeconds);
   const double length = o.seconds > 0.0 ? o.seconds : MotionDesc::forScene(o.scene).duration;
   const std::int64_t frames = std::llround(length * 60.0);  // at most 60 kMaxSeconds
   std::unique_ptr<RunWriter> writer;
   try {
     if (!prepareOutFolder(dir, RunFolderKind::Walk, error)) throw std::runtime_error(error);
-    writer = std::make_unique<RunWriter>(dir, !noFrames, run->characterCount());
+    // A crowd without frames writes nothing per character but the summary (colliders.jsonl would hold
+    // every character's colliders in every frame).
+    const bool writeColliders = !(noFrames && o.scene == SceneKind::Crowd);
+    writer = std::make_unique<RunWriter>(dir, !noFrames, run->characterCount(), writeColliders);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cape_walk: %s\n", e.what());
     return 1;
@@ -225,7 +245,7 @@ int main(int argc, char** argv) {
         if (gltfRecorder) gltfRecorder->record(k, cape.fabric(), v.positions, v.colliders);
         if (renderer) renderer->record(k, v.mesh, v.colliders);
       }
-      if (!kept) continue;
+      if (!kept || !writer->writesColliders()) continue;
       for (Collider c : *colliders) {
         if (run->characterCount() > 1) c.name = "k" + std::to_string(k) + "/" + c.name;
         allColliders.push_back(std::move(c));
@@ -273,8 +293,11 @@ int main(int argc, char** argv) {
   summary["seconds"] = length;
   summary["settings"] = settingsJson(settingsForScene(o.scene, o.settings));
   summary["summary"] = summaryFigures(timings, q);
+  summary["summary"].update(frameShareFigures(timings, run->characterCount()));
   summary["summary"]["lowest_particle_m"] = std::isfinite(lowest) ? lowest : 0.0;
   summary["up"] = o.up == character::UpAxis::Z ? "z" : "y";
+  summary["scene_build_s"] = buildSeconds;
+  summary["bullet_objects"] = run->worldObjectCount();
   // Each cape's final state (stateHash: the bits of its positions and velocities), for determinism checks.
   for (int k = 0; k < run->characterCount(); ++k) {
     char hex[32];
@@ -294,6 +317,10 @@ int main(int argc, char** argv) {
               s["frame_time_us_p95"].get<double>());
   std::printf("  %-34s %10.1f us (p95 %.1f)\n", "cape time, median", s["cape_time_us_median"].get<double>(),
               s["cape_time_us_p95"].get<double>());
+  std::printf("  %-34s %10.1f us (p95 %.1f)\n", "Bullet's own time, median",
+              s["bullet_time_us_median"].get<double>(), s["bullet_time_us_p95"].get<double>());
+  std::printf("  %-34s %10.2f us\n", "cape time per cape, median",
+              s["cape_time_per_cape_us_median"].get<double>());
   std::printf("  %-34s %10.2f %%  (median frame %.2f %%, p95 frame %.2f %%)\n", "strain, max",
               100.0 * q.maxStrain, 100.0 * q.medianFrameMaxStrain, 100.0 * q.p95FrameMaxStrain);
   std::printf("  %-34s %10.3f %%\n", "strain, mean", 100.0 * q.meanStrain);

@@ -115,7 +115,7 @@ TEST(CliNumbers, EveryBadNumberIsRefusedBeforeAnythingIsWritten) {
       {"--seconds 2s", "--seconds: '2s' is not a decimal number"},
       {"--size 0x10", "--size: '0x10' is not a whole number; give a whole number from 2 to 256"},
       {"--size 4294967316", "--size: '4294967316' is out of range"},
-      {"--characters 65", "--characters: '65' is out of range; give a whole number from 1 to 64"},
+      {"--characters 4097", "--characters: '4097' is out of range; give a whole number from 1 to 4096"},
       {"--scale nan", "--scale: 'nan' is not a decimal number; give a number from 0.001 to 1000"},
       {"--root-height 1e309", "--root-height: '1e309' is out of range; give a number from -1000 to 1000"},
       {"--origin 1,2", "--origin: '1,2' is not X,Y,Z"},

@@ -58,21 +58,27 @@ TEST(FarOrigin, TheWalkTenKilometresAwayIsTheWalkAtTheOrigin) {
 }
 
 TEST(FarOrigin, CrowdOutputsAreInOneFrameThoughEachCapeHasItsOwn) {
-  // Twelve characters 2 m apart: the outer ones are more than half a frame spacing (8 m) from the origin,
-  // so their capes simulate in frames of their own; what is written must not show it.
+  // A hundred characters on docs/SCENES.md's 10 x 10 grid, 2 m apart: the outer rows and columns are 9 m
+  // from the origin, more than half a frame spacing (8 m), so their capes simulate in frames of their own;
+  // what is written must not show it.
+  constexpr int kCount = 100, kColumns = 10;
   const fs::path dir = freshDir();
-  const Result r = run(std::string(CAPE_WALK) + " --scene crowd --characters 12 --seconds 0.5 --out " +
-                       (dir / "crowd").string());
+  const Result r = run(std::string(CAPE_WALK) + " --scene crowd --characters " + std::to_string(kCount) +
+                       " --size 6 --seconds 0.25 --out " + (dir / "crowd").string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const std::vector<std::string> jsonl = lines(dir / "crowd" / "colliders.jsonl");
   ASSERT_FALSE(jsonl.empty());
   const json last = json::parse(jsonl.back());
-  for (int k = 0; k < 12; ++k) {
+  std::array<double, 3> first{};
+  for (int k = 0; k < kCount; ++k) {
     char name[32];
     std::snprintf(name, sizeof name, "k%d/%05d.obj", k, static_cast<int>(jsonl.size()));
     const auto c = meanVertex(dir / "crowd" / "frames" / name);
-    const double expectedX = 2.0 * (k - 5.5);
+    if (k == 0) first = c;
+    const double expectedX = 2.0 * (k % kColumns - 4.5);
+    const double rowZ = 2.0 * (k / kColumns);  // behind the first row
     EXPECT_NEAR(c[0], expectedX, 0.5) << "character " << k;
+    EXPECT_NEAR(c[2] - first[2], rowZ, 0.05) << "character " << k;
     // Its colliders are beside it too.
     double sumX = 0.0;
     int n = 0;
