@@ -127,7 +127,7 @@ TEST(SpringKernel, ASpringWhoseSquaredLengthOverflowsIsLeftAlone) {
   const SpringSet& set = fabric->springs(SpringFamily::Structural);
   for (const bool vector : {false, true}) {
     std::vector<float> x{0.0f, 2e19f, 0.0f, 1.0f}, y{0.0f, 0.0f, -1.0f, -1.0f}, z(4, 0.0f), w(4, 1.0f);
-    std::vector<float> lambda(set.size(), 0.0f), inv(set.size(), 0.5f);
+    std::vector<float> lambda(set.size(), 0.0f);
     detail::SpringSolveArrays a;
     a.px = x.data();
     a.py = y.data();
@@ -136,7 +136,6 @@ TEST(SpringKernel, ASpringWhoseSquaredLengthOverflowsIsLeftAlone) {
     a.first = set.first.data();
     a.second = set.second.data();
     a.restLength = set.restLength.data();
-    a.invDenominator = inv.data();
     a.lambda = lambda.data();
     if (vector)
       for (const SpringRun& run : set.runs) detail::solveSpringRun(a, run, 0.0f);

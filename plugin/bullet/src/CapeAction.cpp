@@ -265,11 +265,14 @@ const btRigidBody* CapeAction::referenceBody() const {
 }
 
 void CapeAction::addCollider(const btCollisionObject* object) {
-  if (object != nullptr) track(object).explicitCollider = true;
+  if (object == nullptr) return;
+  track(object).explicitCollider = true;
+  changed_ = true;
 }
 
 void CapeAction::removeCollider(const btCollisionObject* object) {
   if (Tracked* t = find(object)) t->explicitCollider = false;
+  changed_ = true;
 }
 
 // --- One step -----------------------------------------------------------------------------------------
@@ -323,6 +326,7 @@ void CapeAction::dropMissing(btCollisionWorld* world) {
 
 void CapeAction::discover(btCollisionWorld* world) {
   for (Tracked& t : tracked_) t.discovered = false;
+  discoveryChanged_ = false;
   if (!settings_.discoverColliders) return;
   // The cape's bounds at the start of the step, grown by its thickness and the discovery margin, in the
   // world (the frame's origin added in double).
@@ -346,11 +350,24 @@ void CapeAction::discover(btCollisionWorld* world) {
   found_.erase(std::unique(found_.begin(), found_.end(),
                            [](const auto& a, const auto& b) { return a.first == b.first; }),
                found_.end());
+  discoveryChanged_ = found_ != lastFound_;
+  if (discoveryChanged_) lastFound_ = found_;  // keeps its capacity
   for (const auto& [index, object] : found_) {
     Tracked& t = track(object);
     t.discovered = true;
     t.worldIndex = index;
   }
+}
+
+bool CapeAction::resting() const {
+  if (!cape_.isAsleep() || discoveryChanged_ || changed_) return false;
+  for (const Tracked& t : tracked_) {
+    // Where Bullet has it now is where the action last read it, and the motion read then is spent.
+    if (!sameTransform(t.object->getWorldTransform(), t.lastSeen) || t.jumped ||
+        !sameTransform(t.stepStart, t.stepEnd) || !sameTransform(t.stepEnd, t.segmentEnd))
+      return false;
+  }
+  return true;
 }
 
 void CapeAction::advancePoses(btScalar dt) {
@@ -595,12 +612,20 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   reportGuard();
   dropMissing(world);
   discover(world);
+  if (resting()) {
+    // Asleep, and nothing it follows has moved or come or gone: the pins and colliders of the last step
+    // stand (Cape::step confirms it and only advances its clock).
+    prepareMicroseconds_ =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    return;
+  }
   advancePoses(dt);
   applyTeleport();
   followReference();
   updatePins();
   applyInertia();  // after the pins have their new targets: it shifts where they start
   buildColliders();
+  changed_ = false;
   prepareMicroseconds_ =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
 }

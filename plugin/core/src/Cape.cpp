@@ -59,7 +59,6 @@ detail::CapeScratch::CapeScratch(const Fabric& fabric) : body(fabric.particleCou
   airVelocity = Points::Zero(n, 3);
   freeMask = Eigen::VectorXf::Ones(n);
   lambda = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.springCount()));
-  invDenominator = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.springCount()));
   selfWeight = Eigen::VectorXf::Zero(n);
   lost.reserve(static_cast<std::size_t>(n));
 }
@@ -111,6 +110,7 @@ std::uint64_t Cape::selfContactSearches() const {
 
 Status Cape::setGravity(const Vec3& gravity) {
   if (!gravity.allFinite()) return Status::error("Cape::setGravity: gravity must be finite");
+  if (gravity != settings_.gravity) wake();
   settings_.gravity = gravity;
   return Status::success();
 }
@@ -128,6 +128,7 @@ Status Cape::setSettings(const CapeSettings& settings) {
     }
   }
   settings_ = settings;
+  wake();
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const float k = stiffnessOf(settings_, f);
     familyCompliance_[static_cast<std::size_t>(f)] = k > 0.0f ? 1.0f / k : kInf;  // inf compliance = off
@@ -138,6 +139,7 @@ Status Cape::setSettings(const CapeSettings& settings) {
 std::size_t Cape::pin(std::uint32_t particle, const Vec3& target) {
   if (!ok() || particle >= fabric_->particleCount() || !target.allFinite())
     return static_cast<std::size_t>(-1);
+  wake();
   for (std::size_t k = 0; k < state_.pins.size(); ++k) {
     if (state_.pins[k].particle == particle) {
       state_.pins[k].previousTarget = state_.pins[k].target = target;
@@ -155,6 +157,7 @@ void Cape::unpin(std::uint32_t particle) {
   auto it = std::find_if(state_.pins.begin(), state_.pins.end(),
                          [&](const Pin& p) { return p.particle == particle; });
   if (it == state_.pins.end()) return;
+  wake();
   state_.pins.erase(it);
   state_.inverseMasses[particle] = 1.0f / fabric_->masses()[particle];
   markPinnedComponents();
@@ -174,6 +177,8 @@ void Cape::markPinnedComponents() {
 
 void Cape::setOrigin(const Eigen::Vector3d& origin) {
   if (!ok() || !origin.allFinite()) return;
+  if (origin == origin_) return;
+  wake();
   // Frame coordinates change by old - new, computed in double and rounded once.
   const Vec3 d = (origin_ - origin).cast<float>();
   origin_ = origin;
@@ -188,11 +193,14 @@ void Cape::setOrigin(const Eigen::Vector3d& origin) {
 }
 
 void Cape::relocate(const Eigen::Vector3d& origin) {
-  if (ok() && origin.allFinite()) origin_ = origin;
+  if (!ok() || !origin.allFinite() || origin == origin_) return;
+  wake();  // the colliders it sleeps among are in the old frame's coordinates
+  origin_ = origin;
 }
 
 void Cape::teleport(const Pose& delta) {
   if (!ok() || !delta.isFinite()) return;
+  wake();
   reference_.position = delta.apply(reference_.position);
   reference_.rotation = (delta.rotation * reference_.rotation).normalized();
   const Eigen::Matrix3f r = delta.rotation.toRotationMatrix();
@@ -208,6 +216,8 @@ void Cape::teleport(const Pose& delta) {
 
 void Cape::carry(const Eigen::Matrix3f& m, const Vec3& centre, const Vec3& shift) {
   if (!ok() || !m.allFinite() || !centre.allFinite() || !shift.allFinite()) return;
+  if (m == Eigen::Matrix3f::Identity() && shift.isZero()) return;  // carries nothing
+  wake();
   reference_.position = m * (reference_.position - centre) + centre + shift;
   reference_.rotation = (Quat(m) * reference_.rotation).normalized();
   for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
@@ -221,8 +231,17 @@ void Cape::carry(const Eigen::Matrix3f& m, const Vec3& centre, const Vec3& shift
 void Cape::step(float dt, ColliderSpan colliders) {
   if (!ok() || !std::isfinite(dt) || !(dt > 0.0f)) return;
   dt = std::min(dt, kMaxStep);
+  const bool still = surroundingsStill(colliders);
+  if (asleep_) {
+    if (still && work_->sleep.same(colliders)) {
+      state_.time += static_cast<double>(dt);
+      ++sleptSteps_;
+      return;
+    }
+    wake();
+  }
   const StepPlan plan = planSubsteps(dt);
-  beginStep(plan, dt, colliders);
+  beginStep(dt, colliders);
   int searchEvery = 0;  // substeps between self-contact searches inside the loop; 0: none there
   if (settings_.selfCollision && settings_.integrator == Integrator::Xpbd)
     searchEvery = work_->self.schedule(state_, work_->freeMask, settings_, dt, plan.substeps);
@@ -238,6 +257,47 @@ void Cape::step(float dt, ColliderSpan colliders) {
       substepExplicit(plan.h, s0, s1, colliders);
   }
   endStep(dt);
+  updateSleep(dt, still, colliders);
+}
+
+void Cape::wake() {
+  asleep_ = false;
+  stillTime_ = 0.0f;
+}
+
+bool Cape::surroundingsStill(ColliderSpan colliders) const {
+  if (!(settings_.sleepSpeed > 0.0f) || settings_.wind.model != WindSettings::Model::None) return false;
+  for (const Pin& p : state_.pins)
+    if (p.target != p.previousTarget) return false;
+  for (const Collider& c : colliders)
+    if (c.previous.position != c.current.position ||
+        c.previous.rotation.coeffs() != c.current.rotation.coeffs())
+      return false;
+  return true;
+}
+
+void Cape::updateSleep(float dt, bool still, ColliderSpan colliders) {
+  // Asleep once every particle has been slow for sleepDelay with nothing around it moving. The test reads
+  // the velocities once per step (the speed of a pinned particle is its still pin's: zero).
+  if (!still) {
+    stillTime_ = 0.0f;
+    return;
+  }
+  const float limit2 = settings_.sleepSpeed * settings_.sleepSpeed;
+  const float *vx = state_.velocities.col(0).data(), *vy = state_.velocities.col(1).data(),
+              *vz = state_.velocities.col(2).data();
+  float fastest2 = 0.0f;
+  for (Eigen::Index i = 0, n = state_.velocities.rows(); i < n; ++i)
+    fastest2 = std::max(fastest2, vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i]);
+  if (!(fastest2 < limit2)) {
+    stillTime_ = 0.0f;
+    return;
+  }
+  stillTime_ += dt;
+  if (stillTime_ < settings_.sleepDelay) return;
+  asleep_ = true;
+  state_.velocities.setZero();
+  work_->sleep.remember(colliders);
 }
 
 Cape::StepPlan Cape::planSubsteps(float dt) const {
@@ -260,10 +320,9 @@ Cape::StepPlan Cape::planSubsteps(float dt) const {
   return {substeps, dt / static_cast<float>(substeps)};
 }
 
-void Cape::beginStep(const StepPlan& plan, float dt, ColliderSpan colliders) {
+void Cape::beginStep(float dt, ColliderSpan colliders) {
   // 1 for free particles, 0 for pinned ones (same size every step: no allocation).
   work_->freeMask = (state_.inverseMasses.array() > 0.0f).cast<float>();
-  if (settings_.integrator == Integrator::Xpbd) prepareSpringDenominators(plan.h);
   // The air's velocity at each particle, once per step at its middle: gusts change over tenths of a second,
   // far slower than a frame.
   if (settings_.wind.model != WindSettings::Model::None)
@@ -470,6 +529,20 @@ void Cape::substepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
 
 void Cape::predict(float h) {
   // x* = x + h v + h^2 a: symplectic Euler on the external forces.
+  if (settings_.wind.model == WindSettings::Model::None) {
+    // Gravity alone: the same operations, v + h (free g), without the acceleration array and its traffic.
+    for (int c = 0; c < 3; ++c) {
+      const float g = settings_.gravity[c];
+      float* __restrict v = state_.velocities.col(c).data();
+      float* __restrict x = state_.positions.col(c).data();
+      const float* __restrict free = work_->freeMask.data();
+      for (Eigen::Index i = 0, n = state_.positions.rows(); i < n; ++i) {
+        v[i] += h * (free[i] * g);
+        x[i] += h * v[i];
+      }
+    }
+    return;
+  }
   accumulateExternalAcceleration();
   state_.velocities += h * work_->acceleration;
   state_.positions += h * state_.velocities;
@@ -479,7 +552,9 @@ void Cape::solveConstraints(float h) {
   // Tethers first (they fix the global stretch in one pass), then the springs, which are left with only
   // local corrections, then the self-contacts. Collisions come after, so the cape ends every substep outside
   // the colliders.
-  work_->lambda.setZero();
+  // The multipliers start every substep at zero; with one iteration they are never read again, so none is
+  // kept (SpringSolveArrays::lambda null).
+  if (settings_.iterations > 1) work_->lambda.setZero();
   for (int it = 0; it < settings_.iterations; ++it) {
     if (settings_.useTethers) solveTethers();
     solveSprings(h);
@@ -527,24 +602,6 @@ void Cape::updateVelocities(float h) {
   }
 }
 
-void Cape::prepareSpringDenominators(float h) {
-  // 1 / (w_i + w_j + alpha / h^2) of every spring: constant over the step's substeps, so the solver loop
-  // multiplies instead of dividing. 0 when both ends are pinned (no correction).
-  const float invH2 = 1.0f / (h * h);
-  const float* w = state_.inverseMasses.data();
-  float* out = work_->invDenominator.data();
-  for (int f = 0; f < kSpringFamilyCount; ++f) {
-    const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
-    const float compliance = familyCompliance_[static_cast<std::size_t>(f)];
-    const float alpha = std::isinf(compliance) ? 0.0f : compliance * invH2;
-    for (std::size_t s = 0; s < set.size(); ++s) {
-      const float wsum = w[set.first[s]] + w[set.second[s]];
-      out[s] = wsum > 0.0f ? 1.0f / (wsum + alpha) : 0.0f;
-    }
-    out += set.size();
-  }
-}
-
 void Cape::solveSprings(float h) {
   // XPBD distance constraints, family after family, each family's springs in its fabric order (colour after
   // colour); the kernel and its equations are in SpringSolver.h.
@@ -553,8 +610,7 @@ void Cape::solveSprings(float h) {
   arrays.py = state_.positions.col(1).data();
   arrays.pz = state_.positions.col(2).data();
   arrays.inverseMass = state_.inverseMasses.data();
-  arrays.lambda = work_->lambda.data();
-  arrays.invDenominator = work_->invDenominator.data();
+  arrays.lambda = settings_.iterations > 1 ? work_->lambda.data() : nullptr;
   const float invH2 = 1.0f / (h * h);
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
@@ -565,8 +621,7 @@ void Cape::solveSprings(float h) {
       arrays.restLength = set.restLength.data();
       for (const SpringRun& run : set.runs) detail::solveSpringRun(arrays, run, compliance * invH2);
     }
-    arrays.lambda += set.size();
-    arrays.invDenominator += set.size();
+    if (arrays.lambda != nullptr) arrays.lambda += set.size();
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include "BodyCollision.h"
 #include "SelfCollision.h"
+#include "SleepRecord.h"
 
 namespace cape::detail {
 
@@ -14,12 +15,12 @@ struct CapeScratch {
   Points acceleration;              ///< External acceleration per particle (gravity + wind), m/s^2.
   Points airVelocity;               ///< The wind's velocity at each particle for this step, m/s.
   Eigen::VectorXf freeMask;         ///< 1 for free particles, 0 for pinned, refreshed each step.
-  Eigen::VectorXf lambda;           ///< XPBD Lagrange multipliers of every spring, per substep.
-  Eigen::VectorXf invDenominator;   ///< 1 / (w_i + w_j + alpha~) of every spring, per step.
+  Eigen::VectorXf lambda;           ///< XPBD Lagrange multipliers of every spring (iterations > 1).
   Eigen::VectorXf selfWeight;       ///< Inverse masses for the last self-contact pass, 1/kg.
   std::vector<std::uint32_t> lost;  ///< The numerical guard's finds in one step (capacity: every particle).
   BodyCollision body;
   SelfCollision self;
+  SleepRecord sleep;  ///< The colliders a sleeping cape fell asleep among.
 };
 
 }  // namespace cape::detail

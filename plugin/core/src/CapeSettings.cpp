@@ -65,6 +65,8 @@ Status CapeSettings::validate() const {
     return Status::error("CapeSettings: timeStep must be in 1e-5..1 s");
   if (!(std::isfinite(guardReach) && guardReach > 0.0f))
     return Status::error("CapeSettings: guardReach must be finite and > 0 (rest diameters)");
+  if (!finiteNonNegative(sleepSpeed) || !finiteNonNegative(sleepDelay))
+    return Status::error("CapeSettings: sleepSpeed (m/s) and sleepDelay (s) must be finite and >= 0");
   if (wind.model != WindSettings::Model::None) {
     if (!wind.direction.allFinite() || !(wind.direction.norm() > 0.0f))
       return Status::error("CapeSettings: wind direction must be a finite nonzero vector");

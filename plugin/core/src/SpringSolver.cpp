@@ -13,8 +13,11 @@ namespace cape::detail {
 // The largest squared length a spring is solved at: beyond it the square has overflowed (or nearly).
 constexpr float kMaxLength2 = std::numeric_limits<float>::max();
 
-void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end,
-                        float alphaTilde) {
+namespace {
+
+// solveSpringsScalar's loop; without multipliers (kLambda false) every lambda is zero and none is stored.
+template <bool kLambda>
+void scalarSprings(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde) {
   float* __restrict px = a.px;
   float* __restrict py = a.py;
   float* __restrict pz = a.pz;
@@ -27,12 +30,19 @@ void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::ui
     const float wi = w[i], wj = w[j];
     const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
     const float len2 = dx * dx + dy * dy + dz * dz;
-    // invDenominator is 0 when both ends are pinned; a zero length has no direction, and a length whose
-    // square overflows (a runaway particle, restored by the cape's guard after the step) no finite one.
+    // A zero length has no direction, and a length whose square overflows (a runaway particle, restored by
+    // the cape's guard after the step) no finite one.
     if (!(len2 > 1e-18f && len2 <= kMaxLength2)) continue;
+    const float wsum = wi + wj;
+    const float invDenominator = wsum > 0.0f ? 1.0f / (wsum + alphaTilde) : 0.0f;  // 0: both ends pinned
     const float len = std::sqrt(len2);
-    const float dl = (a.restLength[s] - len - alphaTilde * lambda[s]) * a.invDenominator[s];
-    lambda[s] += dl;
+    float dl;
+    if constexpr (kLambda) {
+      dl = (a.restLength[s] - len - alphaTilde * lambda[s]) * invDenominator;
+      lambda[s] += dl;
+    } else {
+      dl = (a.restLength[s] - len) * invDenominator;
+    }
     const float k = dl / len;
     const float cx = k * dx, cy = k * dy, cz = k * dz;
     px[i] -= wi * cx;
@@ -42,6 +52,16 @@ void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::ui
     py[j] += wj * cy;
     pz[j] += wj * cz;
   }
+}
+
+}  // namespace
+
+void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end,
+                        float alphaTilde) {
+  if (a.lambda != nullptr)
+    scalarSprings<true>(a, begin, end, alphaTilde);
+  else
+    scalarSprings<false>(a, begin, end, alphaTilde);
 }
 
 void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers,
@@ -157,10 +177,11 @@ inline __m128 select(__m128 mask, __m128 ifTrue, __m128 ifFalse) {
 
 // solveSpringsScalar's body in four lanes. A lane whose spring has no direction keeps its old values (a
 // select, not a multiplication by zero, so not even the sign of a zero changes).
-template <SpringLayout L>
+template <SpringLayout L, bool kLambda>
 void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde) {
   using In = Lanes<L>;
   const __m128 alpha = _mm_set1_ps(alphaTilde);
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
   const __m128 minLen2 = _mm_set1_ps(1e-18f);
   const __m128 maxLen2 = _mm_set1_ps(kMaxLength2);
   for (std::uint32_t s = begin; s < end; s += 4) {
@@ -175,12 +196,19 @@ void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t 
     const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
     const __m128 active =  // false for NaN and for an overflowed square too
         _mm_and_ps(_mm_cmpgt_ps(len2, minLen2), _mm_cmple_ps(len2, maxLen2));
+    const __m128 wsum = _mm_add_ps(wi, wj);
+    const __m128 invDenominator =
+        _mm_and_ps(_mm_cmpgt_ps(wsum, zero), _mm_div_ps(one, _mm_add_ps(wsum, alpha)));
     const __m128 len = _mm_sqrt_ps(len2);
-    const __m128 lambda = _mm_loadu_ps(a.lambda + s);
-    const __m128 dl =
-        _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(a.restLength + s), len), _mm_mul_ps(alpha, lambda)),
-                   _mm_loadu_ps(a.invDenominator + s));
-    _mm_storeu_ps(a.lambda + s, select(active, _mm_add_ps(lambda, dl), lambda));
+    __m128 dl;
+    if constexpr (kLambda) {
+      const __m128 lambda = _mm_loadu_ps(a.lambda + s);
+      dl = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(a.restLength + s), len), _mm_mul_ps(alpha, lambda)),
+                      invDenominator);
+      _mm_storeu_ps(a.lambda + s, select(active, _mm_add_ps(lambda, dl), lambda));
+    } else {
+      dl = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(a.restLength + s), len), invDenominator);
+    }
     const __m128 k = _mm_div_ps(dl, len);
     const __m128 cx = _mm_mul_ps(k, dx), cy = _mm_mul_ps(k, dy), cz = _mm_mul_ps(k, dz);
     In::store(a.px, p, q, select(active, _mm_sub_ps(xi, _mm_mul_ps(wi, cx)), xi),
@@ -190,6 +218,25 @@ void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t 
     In::store(a.pz, p, q, select(active, _mm_sub_ps(zi, _mm_mul_ps(wi, cz)), zi),
               select(active, _mm_add_ps(zj, _mm_mul_ps(wj, cz)), zj));
   }
+}
+
+template <bool kLambda>
+void solveRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
+  switch (run.layout) {
+    case SpringLayout::Contiguous:
+      return solveBlocks<SpringLayout::Contiguous, kLambda>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::PairSwapped:
+      return solveBlocks<SpringLayout::PairSwapped, kLambda>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Interleaved:
+      return solveBlocks<SpringLayout::Interleaved, kLambda>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Pairs:
+      return solveBlocks<SpringLayout::Pairs, kLambda>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Gathered:
+      return solveBlocks<SpringLayout::Gathered, kLambda>(a, run.begin, run.end, alphaTilde);
+    case SpringLayout::Scalar:
+      break;
+  }
+  scalarSprings<kLambda>(a, run.begin, run.end, alphaTilde);
 }
 
 }  // namespace
@@ -230,21 +277,10 @@ void solveTethers(float* px, float* py, float* pz, const float* inverseMass, con
 }
 
 void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
-  switch (run.layout) {
-    case SpringLayout::Contiguous:
-      return solveBlocks<SpringLayout::Contiguous>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::PairSwapped:
-      return solveBlocks<SpringLayout::PairSwapped>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Interleaved:
-      return solveBlocks<SpringLayout::Interleaved>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Pairs:
-      return solveBlocks<SpringLayout::Pairs>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Gathered:
-      return solveBlocks<SpringLayout::Gathered>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Scalar:
-      break;
-  }
-  solveSpringsScalar(a, run.begin, run.end, alphaTilde);
+  if (a.lambda != nullptr)
+    solveRun<true>(a, run, alphaTilde);
+  else
+    solveRun<false>(a, run, alphaTilde);
 }
 
 #else

@@ -10,7 +10,9 @@
 namespace cape::detail {
 
 /// The arrays one family's solve reads and writes: positions as three columns, inverse masses, and per
-/// spring (indexed like the SpringSet) its rest length, 1 / (w_i + w_j + alpha~) and XPBD multiplier.
+/// spring (indexed like the SpringSet) its rest length and XPBD multiplier. `lambda` may be null: every
+/// multiplier is then taken as zero and none is kept (one iteration per substep, where the multipliers start
+/// at zero and are never read again), which saves the array and its traffic and gives the same positions.
 struct SpringSolveArrays {
   float* px = nullptr;
   float* py = nullptr;
@@ -19,15 +21,17 @@ struct SpringSolveArrays {
   const std::uint32_t* first = nullptr;
   const std::uint32_t* second = nullptr;
   const float* restLength = nullptr;
-  const float* invDenominator = nullptr;
   float* lambda = nullptr;
 };
 
 /// XPBD distance constraints C = |xj - xi| - L with compliance alpha (Macklin et al. 2016):
 ///   dlambda = (-C - alpha~ lambda) / (wi + wj + alpha~),  alpha~ = alpha / h^2,
 ///   xi -= wi dlambda n,  xj += wj dlambda n,  n = (xj - xi) / |xj - xi|,
-/// for springs [begin, end) one after another. A spring of zero (or non-finite) length has no direction and
-/// is left alone. `alphaTilde` is alpha / h^2.
+/// for springs [begin, end) one after another. The division is a multiplication by 1 / (wi + wj + alpha~)
+/// (0 when both ends are pinned), taken per spring as it is solved: reading the inverse masses the spring
+/// needs anyway costs less than a per-step table of denominators would in memory traffic, and a world
+/// stepping the cape once per substep pays no pass over the springs before the solve. A spring of zero (or
+/// non-finite) length has no direction and is left alone. `alphaTilde` is alpha / h^2.
 void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde);
 
 /// The same over a run, four springs at a time with vector loads and stores where the run's layout allows

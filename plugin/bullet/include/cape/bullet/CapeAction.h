@@ -113,7 +113,10 @@ class CapeAction : public btActionInterface {
   /// The core cape (settings, pins, state). Prefer the attach/detach methods for body pins.
   Cape& cape() { return cape_; }
   const CapeActionSettings& actionSettings() const { return settings_; }
-  void setActionSettings(const CapeActionSettings& settings) { settings_ = settings; }
+  void setActionSettings(const CapeActionSettings& settings) {
+    settings_ = settings;
+    changed_ = true;
+  }
   void setWarningHandler(WarningHandler handler) { warn_ = std::move(handler); }
 
   // --- Attachments --------------------------------------------------------------------------------------
@@ -136,7 +139,10 @@ class CapeAction : public btActionInterface {
   void detachAll();
   const std::vector<Attachment>& attachments() const { return attachments_; }
   /// The body whose motion inertia and teleports refer to: set here, else the first attachment's body.
-  void setReferenceBody(const btRigidBody* body) { referenceBody_ = body; }
+  void setReferenceBody(const btRigidBody* body) {
+    referenceBody_ = body;
+    changed_ = true;
+  }
 
   // --- Colliders ---------------------------------------------------------------------------------------
   /// Always collide with `object` (whether or not discovery is on or would find it).
@@ -218,6 +224,8 @@ class CapeAction : public btActionInterface {
   void followGravity(btCollisionWorld* world);
   void dropMissing(btCollisionWorld* world);
   void discover(btCollisionWorld* world);
+  /// Asleep with nothing followed moving, coming or going: the step needs nothing new from the world.
+  bool resting() const;
   void advancePoses(btScalar dt);
   void applyTeleport();
   void applyInertia();
@@ -250,6 +258,9 @@ class CapeAction : public btActionInterface {
   std::unordered_map<const btCollisionObject*, std::size_t> trackedIndex_;
   /// Discovery's scratch: (world array index, object) of every object the broadphase reported this step.
   std::vector<std::pair<int, const btCollisionObject*>> found_;
+  std::vector<std::pair<int, const btCollisionObject*>> lastFound_;  ///< found_ of the step before
+  bool discoveryChanged_ = true;
+  bool changed_ = true;  ///< Colliders, settings or the reference body changed since the last full prepare.
 
   std::vector<Collider> colliders_;
   std::vector<const btCollisionObject*> activeObjects_;

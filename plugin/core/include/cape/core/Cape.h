@@ -53,8 +53,12 @@ class Cape {
   /// an error, and the gravity stays what it was.
   Status setGravity(const Vec3& gravity);
   const CapeState& state() const { return state_; }
-  /// Direct access for tools and tests; keep inverse masses and pins consistent (use pin()/unpin()).
-  CapeState& mutableState() { return state_; }
+  /// Direct access for tools and tests; keep inverse masses and pins consistent (use pin()/unpin()). Wakes
+  /// the cape (whatever is done with the state may move it).
+  CapeState& mutableState() {
+    wake();
+    return state_;
+  }
 
   /// Pins a particle to a world target (its inverse mass becomes 0). Returns the pin's index.
   /// The particle jumps to the target at the next step. Pinning a pinned particle retargets it.
@@ -111,6 +115,13 @@ class Cape {
   /// teleport() and carry(), and refitted to the pin targets whenever the guard restores a particle.
   const Pose& referencePose() const { return reference_; }
 
+  /// Sleeping (CapeSettings::sleepSpeed): whether the cape is asleep, and how many steps it slept through
+  /// (each only a check that its pins and colliders are still where they were when it fell asleep).
+  bool isAsleep() const { return asleep_; }
+  std::uint64_t sleptSteps() const { return sleptSteps_; }
+  /// Wakes the cape (the next step simulates); what every change to the pins, settings or state does.
+  void wake();
+
   /// A particle that touched a collider in this substep's collision pass (index into the step's colliders).
   struct Contact {
     std::uint32_t particle;
@@ -148,7 +159,7 @@ class Cape {
     float h = 0.0f;
   };
   StepPlan planSubsteps(float dt) const;
-  void beginStep(const StepPlan& plan, float dt, ColliderSpan colliders);
+  void beginStep(float dt, ColliderSpan colliders);
   void endStep(float dt);
   void guardParticles(float dt);
   void fitReferenceToPins();
@@ -165,10 +176,12 @@ class Cape {
   // Their parts.
   void accumulateExternalAcceleration();
   void accumulateSpringForces();
-  void prepareSpringDenominators(float h);
   void solveSprings(float h);
   void solveTethers();
   void adaptRefinement();
+  /// Whether nothing the cape feels moves in this step (pins and colliders still, no wind).
+  bool surroundingsStill(ColliderSpan colliders) const;
+  void updateSleep(float dt, bool still, ColliderSpan colliders);
 
   FabricPtr fabric_;
   CapeSettings settings_;
@@ -179,6 +192,9 @@ class Cape {
   Pose reference_;                                    ///< The rest shape's pose in the frame.
   std::vector<std::uint8_t> pinnedComponent_;         ///< 1 for each fabric component holding a pin.
   GuardReport guard_;
+  bool asleep_ = false;
+  float stillTime_ = 0.0f;  ///< s the cape has been slow with its surroundings still
+  std::uint64_t sleptSteps_ = 0;
   CapeState state_;
   Status status_ = Status::success();
   std::unique_ptr<detail::CapeScratch> work_;  ///< Sized once; null while the cape is not ok().

@@ -69,6 +69,14 @@ struct CapeSettings {
   /// a particle farther from the pins is lost and restored. > 0; the default is far beyond any stretch the
   /// springs allow, so only a runaway trips it.
   float guardReach = 2.0f;
+  /// Sleeping: a cape whose every particle has been slower than sleepSpeed (m/s) for sleepDelay (s) of
+  /// simulated time, with its pins and colliders still and no wind, falls asleep: its velocities become zero
+  /// and step() only checks that nothing changed (no solve, no collision, no guard) until it wakes. It wakes,
+  /// and simulates that very step, when a pin or a collider moves, a collider comes, goes or changes, or the
+  /// settings, the gravity or the state are changed (Cape::isAsleep). 0 never sleeps. The defaults are far
+  /// below any motion an eye can see (1 cm/s for a second: a particle drifting less than 1 cm).
+  float sleepSpeed = 0.01f;
+  float sleepDelay = 1.0f;  ///< s, >= 0
   /// Constraint iterations per substep, >= 1.
   int iterations = 1;
   /// Gravity, m/s^2.

@@ -1,0 +1,207 @@
+// Sleeping (CapeSettings::sleepSpeed): a cape at rest among still colliders stops simulating, changes nothing
+// while asleep, and wakes the very step anything it feels changes.
+#include "cape/core/Cape.h"
+#include "cape/scenes/Scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+namespace cape {
+namespace {
+
+Pose at(const Vec3& position) {
+  Pose p;
+  p.position = position;
+  return p;
+}
+
+// The canonical cape hung by its two top corners in front of a still torso box and shoulder spheres.
+struct Hanging {
+  CapeRig rig = makeCapeRig(20, PinLayout::Corners);
+  Cape cape;
+  std::vector<Collider> colliders;
+
+  explicit Hanging(const CapeSettings& settings)
+      : cape(rig.fabric, settings, capeStartPlacement(SceneKind::Walk)) {
+    EXPECT_TRUE(cape.ok()) << cape.status().message();
+    for (std::size_t k = 0; k < rig.pinnedParticles.size(); ++k)
+      cape.pin(rig.pinnedParticles[k], rig.pinLocalPoints[k]);
+    colliders.push_back(Collider::box(Vec3(0.18f, 0.3f, 0.1f), at(Vec3(0.0f, 1.2f, 0.0f))));
+    colliders.push_back(Collider::sphere(0.08f, at(Vec3(-0.22f, 1.52f, 0.0f))));
+    colliders.push_back(Collider::sphere(0.08f, at(Vec3(0.22f, 1.52f, 0.0f))));
+  }
+  void frames(int count) {
+    for (int f = 0; f < count; ++f) cape.step(1.0f / 60.0f, colliders);
+  }
+  // Moves every pin by `d` (the pins' targets at the end of the next step).
+  void movePins(const Vec3& d) {
+    for (std::size_t k = 0; k < cape.state().pins.size(); ++k)
+      cape.movePin(k, cape.state().pins[k].target + d);
+  }
+};
+
+float largestDifference(const Points& a, const Points& b) {
+  return (a - b).rowwise().norm().maxCoeff();
+}
+
+bool sameBits(const Points& a, const Points& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(float) * a.size()) == 0;
+}
+
+CapeSettings neverSleeps() {
+  CapeSettings s;
+  s.sleepSpeed = 0.0f;
+  return s;
+}
+
+TEST(Sleep, AHangingCapeFallsAsleepWhereItWouldHaveHung) {
+  Hanging asleep{CapeSettings()}, awake{neverSleeps()};
+  asleep.frames(600);
+  awake.frames(600);
+  EXPECT_TRUE(asleep.cape.isAsleep());
+  EXPECT_GT(asleep.cape.sleptSteps(), 0u);
+  EXPECT_FALSE(awake.cape.isAsleep());
+  EXPECT_EQ(awake.cape.sleptSteps(), 0u);
+  // What it skipped is the last drift of a cape at rest: far below a millimetre.
+  EXPECT_LT(largestDifference(asleep.cape.state().positions, awake.cape.state().positions), 1e-3f);
+  EXPECT_TRUE(asleep.cape.state().velocities.isZero());
+  EXPECT_DOUBLE_EQ(asleep.cape.state().time, awake.cape.state().time);
+}
+
+TEST(Sleep, ASleepingStepChangesNothingButTheClock) {
+  Hanging h{CapeSettings()};
+  h.frames(600);
+  ASSERT_TRUE(h.cape.isAsleep());
+  const CapeState before = h.cape.state();
+  const std::uint64_t slept = h.cape.sleptSteps();
+  h.frames(100);
+  EXPECT_TRUE(h.cape.isAsleep());
+  EXPECT_EQ(h.cape.sleptSteps(), slept + 100);
+  EXPECT_TRUE(sameBits(before.positions, h.cape.state().positions));
+  EXPECT_TRUE(sameBits(before.velocities, h.cape.state().velocities));
+  EXPECT_NEAR(h.cape.state().time, before.time + 100.0 * static_cast<double>(1.0f / 60.0f), 1e-9);
+}
+
+TEST(Sleep, AMovingPinWakesItTheSameStepAndItMovesAsAnAwakeCapeDoes) {
+  Hanging asleep{CapeSettings()}, awake{neverSleeps()};
+  asleep.frames(600);
+  awake.frames(600);
+  ASSERT_TRUE(asleep.cape.isAsleep());
+  const Points rest = asleep.cape.state().positions;
+  asleep.movePins(Vec3(0.02f, 0.0f, 0.0f));
+  awake.movePins(Vec3(0.02f, 0.0f, 0.0f));
+  asleep.frames(1);
+  awake.frames(1);
+  EXPECT_FALSE(asleep.cape.isAsleep());
+  EXPECT_GT(largestDifference(asleep.cape.state().positions, rest), 0.01f);
+  for (int f = 0; f < 60; ++f) {
+    asleep.frames(1);
+    awake.frames(1);
+    ASSERT_LT(largestDifference(asleep.cape.state().positions, awake.cape.state().positions), 2e-3f) << f;
+  }
+}
+
+TEST(Sleep, ColliderChangesWakeIt) {
+  enum Change { Moves, Comes, Goes, Grows };
+  for (const Change change : {Moves, Comes, Goes, Grows}) {
+    Hanging h{CapeSettings()};
+    h.frames(600);
+    ASSERT_TRUE(h.cape.isAsleep());
+    switch (change) {
+      case Moves:
+        h.colliders[0].moveTo(at(h.colliders[0].current.position + Vec3(0.0f, 0.0f, 0.05f)));
+        break;
+      case Comes:
+        h.colliders.push_back(Collider::sphere(0.1f, at(Vec3(0.0f, 1.0f, 0.2f))));
+        break;
+      case Goes:
+        h.colliders.pop_back();
+        break;
+      case Grows:
+        h.colliders[0].halfExtents.z() += 0.05f;
+        break;
+    }
+    h.frames(1);
+    EXPECT_FALSE(h.cape.isAsleep()) << change;
+    EXPECT_EQ(h.cape.sleptSteps() > 0, true);
+  }
+}
+
+TEST(Sleep, ChangesToTheCapeWakeIt) {
+  for (int change = 0; change < 6; ++change) {
+    Hanging h{CapeSettings()};
+    h.frames(600);
+    ASSERT_TRUE(h.cape.isAsleep());
+    switch (change) {
+      case 0:
+        ASSERT_TRUE(h.cape.setGravity(Vec3(0.0f, -9.8f, 1.0f)).ok());
+        break;
+      case 1: {
+        CapeSettings s = h.cape.settings();
+        s.wind.model = WindSettings::Model::Aerodynamic;
+        s.wind.speed = 3.0f;
+        ASSERT_TRUE(h.cape.setSettings(s).ok());
+        break;
+      }
+      case 2:
+        h.cape.teleport(at(Vec3(1.0f, 0.0f, 0.0f)));
+        break;
+      case 3:
+        h.cape.unpin(h.rig.pinnedParticles[0]);
+        break;
+      case 4:
+        h.cape.mutableState().velocities(100, 2) = 1.0f;
+        break;
+      case 5:
+        h.cape.carry(Eigen::Matrix3f::Identity(), Vec3::Zero(), Vec3(0.0f, 0.1f, 0.0f));
+        break;
+    }
+    EXPECT_FALSE(h.cape.isAsleep()) << change;
+  }
+  // Carrying by nothing (what the Bullet adapter's inertia does when the body stands still) is no change.
+  Hanging h{CapeSettings()};
+  h.frames(600);
+  h.cape.carry(Eigen::Matrix3f::Identity(), Vec3(1.0f, 2.0f, 3.0f), Vec3::Zero());
+  h.cape.setGravity(h.cape.settings().gravity);
+  EXPECT_TRUE(h.cape.isAsleep());
+}
+
+TEST(Sleep, NeverInTheWindOrWhenSwitchedOff) {
+  CapeSettings windy;
+  windy.wind.model = WindSettings::Model::Aerodynamic;
+  windy.wind.speed = 0.0f;  // still air, but a wind model: the cape does not sleep in it
+  Hanging w{windy}, off{neverSleeps()};
+  w.frames(600);
+  off.frames(600);
+  EXPECT_FALSE(w.cape.isAsleep());
+  EXPECT_FALSE(off.cape.isAsleep());
+}
+
+TEST(Sleep, ASwingingCapeStaysAwake) {
+  // A cape never slower than the limit for the delay never sleeps: the pins move a little every frame.
+  Hanging h{CapeSettings()};
+  for (int f = 0; f < 600; ++f) {
+    h.movePins(Vec3(f % 120 < 60 ? 0.002f : -0.002f, 0.0f, 0.0f));
+    h.frames(1);
+    ASSERT_FALSE(h.cape.isAsleep()) << f;
+  }
+  EXPECT_EQ(h.cape.sleptSteps(), 0u);
+}
+
+TEST(Sleep, SettingsAreChecked) {
+  CapeSettings s;
+  s.sleepSpeed = -1.0f;
+  EXPECT_FALSE(s.validate().ok());
+  s = CapeSettings();
+  s.sleepDelay = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(s.validate().ok());
+  s.sleepDelay = 0.0f;
+  EXPECT_TRUE(s.validate().ok());
+}
+
+}  // namespace
+}  // namespace cape
