@@ -90,8 +90,31 @@ void BM_WalkFrameSeedExplicit(benchmark::State& state) {
   runFrames(state, SceneKind::Walk, s);
 }
 
+// Sleeping (CapeSettings::sleepSpeed): the hang scene settled for 20 s, then one frame, asleep (the default)
+// against never sleeping. Counter "asleep": 1 when the timed frames slept.
+void BM_HangSettled(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  CapeSettings settings;
+  if (state.range(1) == 0) settings.sleepSpeed = 0.0f;
+  SimpleScene scene(SceneKind::Hang, n, PinLayout::Corners, settingsForScene(SceneKind::Hang, settings));
+  if (!scene.status().ok()) {
+    state.SkipWithError(scene.status().message().c_str());
+    return;
+  }
+  for (int f = 0; f < 1200; ++f) scene.advanceFrame();
+  for (auto _ : state) {
+    scene.advanceFrame();
+    benchmark::DoNotOptimize(scene.cape().state().positions.data());
+  }
+  state.counters["asleep"] = scene.cape().isAsleep() ? 1.0 : 0.0;
+}
+
 }  // namespace
 
+BENCHMARK(BM_HangSettled)
+    ->ArgNames({"n", "sleep"})
+    ->ArgsProduct({{20, 64}, {0, 1}})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrame)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrameAdaptive)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrame4Substeps)->Arg(20)->Unit(benchmark::kMicrosecond);
