@@ -22,12 +22,83 @@ StrainStats structuralStrain(const Fabric& fabric, const Points& x) {
   return s;
 }
 
+namespace {
+
+// The penetration metric culls with a ball about each collider's origin that holds its solid: a particle
+// farther than kReach times its radius from the origin cannot be inside, so it cannot raise the max of
+// max(0, -distance) and its exact distance is not computed. Exact, not approximate, because the margin covers
+// everything between the true distance from the origin and the float figures the shape's distance is made
+// of: a valid pose's quaternion has |q|^2 within 1e-3 of 1, and rotating by it (Eigen's formula, for a unit
+// quaternion) scales a vector's length by a factor in [1 - 2e-3, 1 + 2e-3]; the subtraction and the
+// distances' own float rounding add a few 1e-7 more. Past kReach the local point is more than 0.7 % of the
+// ball's radius outside it, where every shape's float distance is positive.
+constexpr double kReach = 1.01;
+// The culling is only used where that float arithmetic is ordinary: balls of at least kSmallestBound (no
+// denormal squares) and coordinates under kFar (no overflow). Anything else takes the exact path.
+constexpr double kSmallestBound = 1e-10;
+constexpr float kFar = 1e18f;
+
+// The radius of a ball about the collider's local origin that holds every point whose signed distance can be
+// negative, or -1 for a shape left on the exact path (a plane is unbounded; a hull's planes are not checked
+// against its vertices' radius, so its solid is not known to lie within it).
+double solidBound(const Collider& c) {
+  switch (c.shape) {
+    case ColliderShape::Sphere:
+      return c.radius;
+    case ColliderShape::Capsule:  // within radius of the segment
+      return static_cast<double>(c.radius) + c.halfHeight;
+    case ColliderShape::Cylinder:  // rho <= radius and |t| <= halfHeight
+      return std::hypot(static_cast<double>(c.radius), static_cast<double>(c.halfHeight));
+    case ColliderShape::Box:  // |p_k| <= halfExtents_k
+      return c.halfExtents.cast<double>().norm();
+    default:
+      return -1.0;
+  }
+}
+
+}  // namespace
+
 float maxPenetration(const Points& x, ColliderSpan colliders) {
   float worst = 0.0f;
+  // The particles' bounding box, when every coordinate is finite and under kFar (else nothing is culled).
+  bool boxed = x.rows() > 0;
+  float lo[3] = {kFar, kFar, kFar}, hi[3] = {-kFar, -kFar, -kFar};
+  for (Eigen::Index i = 0; i < x.rows() && boxed; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const float v = x(i, k);
+      boxed = boxed && std::abs(v) < kFar;  // false for NaN
+      lo[k] = std::min(lo[k], v);
+      hi[k] = std::max(hi[k], v);
+    }
   for (const Collider& c : colliders) {
     if (!c.validate().ok()) continue;
-    for (Eigen::Index i = 0; i < x.rows(); ++i)
-      worst = std::max(worst, -signedDistance(c, x.row(i).transpose()));
+    // A triangle mesh's distance is unsigned (no inside): never a penetration.
+    if (c.shape == ColliderShape::TriangleMesh) continue;
+    const double bound = solidBound(c);
+    const Vec3& centre = c.current.position;
+    if (!boxed || !(bound >= kSmallestBound) || !(bound < kFar) || !(centre.cwiseAbs().maxCoeff() < kFar)) {
+      for (Eigen::Index i = 0; i < x.rows(); ++i)
+        worst = std::max(worst, -signedDistance(c, x.row(i).transpose()));
+      continue;
+    }
+    const double reach2 = kReach * kReach * bound * bound;
+    // The whole collider: the ball misses the particles' box.
+    double gap2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double g =
+          std::max({static_cast<double>(lo[k]) - centre[k], centre[k] - static_cast<double>(hi[k]), 0.0});
+      gap2 += g * g;
+    }
+    if (gap2 > reach2) continue;
+    // Particle by particle.
+    for (Eigen::Index i = 0; i < x.rows(); ++i) {
+      const Vec3 p = x.row(i).transpose();
+      const Vec3 d = p - centre;
+      const double d2 = static_cast<double>(d.x()) * d.x() + static_cast<double>(d.y()) * d.y() +
+                        static_cast<double>(d.z()) * d.z();
+      if (d2 > reach2) continue;
+      worst = std::max(worst, -signedDistance(c, p));
+    }
   }
   return worst;
 }
@@ -123,10 +194,9 @@ bool coplanarIntersect(const V P[3], const V Q[3], const V& n) {
   return pointInTriangle2d(p[0], q) || pointInTriangle2d(q[0], p);
 }
 
-}  // namespace
-
-bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& q0, const Vec3& q1,
-                        const Vec3& q2) {
+// The interval test alone, on triangles whose boxes overlap.
+bool intervalTest(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& q0, const Vec3& q1,
+                  const Vec3& q2) {
   const V P[3] = {p0.cast<double>(), p1.cast<double>(), p2.cast<double>()};
   const V Q[3] = {q0.cast<double>(), q1.cast<double>(), q2.cast<double>()};
   const V nQ = (Q[1] - Q[0]).cross(Q[2] - Q[0]);
@@ -150,34 +220,224 @@ bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Ve
   return a0 <= b1 && b0 <= a1;
 }
 
+}  // namespace
+
+bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& q0, const Vec3& q1,
+                        const Vec3& q2) {
+  // Triangles whose (closed) boxes are apart on an axis do not meet. Written as comparisons of every pair of
+  // corners, so that a NaN coordinate decides nothing here, as before.
+  for (int k = 0; k < 3; ++k) {
+    const float p[3] = {p0[k], p1[k], p2[k]}, q[3] = {q0[k], q1[k], q2[k]};
+    bool qAbove = true, qBelow = true;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        qAbove = qAbove && q[j] > p[i];
+        qBelow = qBelow && q[j] < p[i];
+      }
+    if (qAbove || qBelow) return false;
+  }
+  return intervalTest(p0, p1, p2, q0, q1, q2);
+}
+
+namespace {
+
+// The spatial hash of the self-intersection count: cubic cells of kCellPerExtent times the mean triangle
+// extent (the largest side of its box), indices clamped to [0, kCellsPerAxis) so that huge or far
+// coordinates stay integers, packed into one key, and a power-of-two table of buckets the keys hash into.
+constexpr double kCellPerExtent = 1.5;
+constexpr int kCellBits = 21;
+constexpr std::int32_t kCellsPerAxis = 1 << (kCellBits - 1);
+// A triangle covering more cells than this (a sliver much longer than the mean) is tested against every
+// triangle instead of being hashed into all of them.
+constexpr std::int64_t kMaxCellsPerTriangle = 64;
+
+std::int32_t cellOf(float v, double origin, double inverseSize) {
+  // Monotone in v (a rounded difference and product, the clamp and the truncation of a value >= 0 are),
+  // which the pair rule relies on. (Truncation rather than std::floor, a libm call without SSE4.1.)
+  const double c = (static_cast<double>(v) - origin) * inverseSize;
+  return static_cast<std::int32_t>(std::clamp(c, 0.0, static_cast<double>(kCellsPerAxis - 1)));
+}
+
+std::uint64_t cellKey(std::int32_t i, std::int32_t j, std::int32_t k) {
+  return static_cast<std::uint64_t>(i) << (2 * kCellBits) | static_cast<std::uint64_t>(j) << kCellBits |
+         static_cast<std::uint64_t>(k);
+}
+
+std::uint32_t bucketOf(std::uint64_t key, std::uint32_t mask) {
+  std::uint64_t h = key * 0x9E3779B97F4A7C15ull;
+  h ^= h >> 29;
+  return static_cast<std::uint32_t>(h >> 32) & mask;
+}
+
+// What the count does with a triangle (SelfIntersectionCounter::isLoose_): hashed; loose as it covers too
+// many cells; or loose and unboxed as it is not finite (tested against every other triangle without a box
+// test, as the brute-force count would).
+constexpr std::uint8_t kHashed = 0, kTooLarge = 1, kUnboxed = 2;
+
+bool shareVertex(const std::uint32_t* a, const std::uint32_t* b) {
+  return a[0] == b[0] || a[0] == b[1] || a[0] == b[2] || a[1] == b[0] || a[1] == b[1] || a[1] == b[2] ||
+         a[2] == b[0] || a[2] == b[1] || a[2] == b[2];
+}
+
+template <class Box>
+bool boxesOverlap(const Box& a, const Box& b) {
+  return !(b.lo[0] > a.hi[0] || b.hi[0] < a.lo[0] || b.lo[1] > a.hi[1] || b.hi[1] < a.lo[1] ||
+           b.lo[2] > a.hi[2] || b.hi[2] < a.lo[2]);
+}
+
+}  // namespace
+
 int SelfIntersectionCounter::count(const Fabric& fabric, const Points& x) {
   const std::vector<std::uint32_t>& tri = fabric.triangles();
   const std::size_t nt = tri.size() / 3;
   boxes_.resize(nt);
+  isLoose_.assign(nt, kHashed);
+  loose_.clear();
+  entries_.clear();
+
+  // Boxes, their mean extent and the box of them all (finite triangles only: the others are loose and
+  // unboxed).
+  double extentSum = 0.0;
+  std::size_t finite = 0;
+  float all[2][3] = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
   for (std::size_t t = 0; t < nt; ++t) {
-    const Vec3 a = x.row(tri[3 * t]), b = x.row(tri[3 * t + 1]), c = x.row(tri[3 * t + 2]);
-    boxes_[t] = {a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c), static_cast<std::uint32_t>(t)};
+    Box& b = boxes_[t];
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) {
+      const float u = x(tri[3 * t], k), v = x(tri[3 * t + 1], k), w = x(tri[3 * t + 2], k);
+      ok = ok && std::isfinite(u) && std::isfinite(v) && std::isfinite(w);
+      b.lo[k] = std::min({u, v, w});
+      b.hi[k] = std::max({u, v, w});
+    }
+    if (!ok) {
+      isLoose_[t] = kUnboxed;
+      loose_.push_back(static_cast<std::uint32_t>(t));
+      continue;
+    }
+    extentSum += std::max({static_cast<double>(b.hi[0]) - b.lo[0], static_cast<double>(b.hi[1]) - b.lo[1],
+                           static_cast<double>(b.hi[2]) - b.lo[2]});
+    for (int k = 0; k < 3; ++k) {
+      all[0][k] = finite == 0 ? b.lo[k] : std::min(all[0][k], b.lo[k]);
+      all[1][k] = finite == 0 ? b.hi[k] : std::max(all[1][k], b.hi[k]);
+    }
+    ++finite;
   }
-  // Sweep and prune along x.
-  std::sort(boxes_.begin(), boxes_.end(), [](const Box& l, const Box& r) {
-    return l.lo.x() < r.lo.x() || (l.lo.x() == r.lo.x() && l.triangle < r.triangle);
-  });
+
+  // The cells: from the mean extent, or coarser if the boxes span more than kCellsPerAxis of them; all in
+  // one cell when everything is one point.
+  double span = 0.0;
+  for (int k = 0; k < 3; ++k) span = std::max(span, static_cast<double>(all[1][k]) - all[0][k]);
+  const double mean = finite > 0 ? extentSum / static_cast<double>(finite) : 0.0;
+  const double size = std::max(kCellPerExtent * mean, span / static_cast<double>(kCellsPerAxis - 1));
+  const double inverse = size > 0.0 ? 1.0 / size : 0.0;
+  std::size_t entries = 0;
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (isLoose_[t] != kHashed) continue;
+    Box& b = boxes_[t];
+    std::int64_t cells = 1;
+    for (int k = 0; k < 3; ++k) {
+      b.cellLo[k] = cellOf(b.lo[k], all[0][k], inverse);
+      b.cellHi[k] = cellOf(b.hi[k], all[0][k], inverse);
+      cells *= b.cellHi[k] - b.cellLo[k] + 1;
+    }
+    if (cells > kMaxCellsPerTriangle) {
+      isLoose_[t] = kTooLarge;
+      loose_.push_back(static_cast<std::uint32_t>(t));
+      continue;
+    }
+    entries += static_cast<std::size_t>(cells);
+  }
+  // About one bucket per entry: a triangle covers a few cells and a cell holds a few triangles, so most
+  // buckets hold one cell.
+  std::size_t buckets = 1;
+  while (buckets < entries) buckets *= 2;
+  const std::uint32_t mask = static_cast<std::uint32_t>(buckets - 1);
+
+  // One entry per hashed triangle and cell it covers, in triangle order, counted per bucket.
+  bucketStart_.assign(buckets, 0);
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (isLoose_[t] != kHashed) continue;
+    const Box& b = boxes_[t];
+    for (std::int32_t i = b.cellLo[0]; i <= b.cellHi[0]; ++i)
+      for (std::int32_t j = b.cellLo[1]; j <= b.cellHi[1]; ++j)
+        for (std::int32_t k = b.cellLo[2]; k <= b.cellHi[2]; ++k) {
+          const std::uint64_t key = cellKey(i, j, k);
+          const std::uint32_t bucket = bucketOf(key, mask);
+          entries_.push_back({key, static_cast<std::uint32_t>(t), bucket});
+          ++bucketStart_[bucket];
+        }
+  }
+  // Counting sort, stable: each bucket's entries in ascending triangle order, each with a copy of its
+  // triangle's box (the pair loop reads them in order). Afterwards bucketStart_[h] is where bucket h ends
+  // (and h + 1 begins).
+  std::uint32_t sum = 0;
+  for (std::uint32_t& s : bucketStart_) {
+    const std::uint32_t n = s;
+    s = sum;
+    sum += n;
+  }
+  sorted_.resize(entries_.size());
+  for (const Entry& e : entries_) {
+    const Box& b = boxes_[e.triangle];
+    const std::uint32_t* v = &tri[3 * e.triangle];
+    sorted_[bucketStart_[e.bucket]++] = {{b.lo[0], b.lo[1], b.lo[2]},
+                                         {b.hi[0], b.hi[1], b.hi[2]},
+                                         {b.cellLo[0], b.cellLo[1], b.cellLo[2]},
+                                         {v[0], v[1], v[2]},
+                                         e.triangle,
+                                         e.key};
+  }
+
   int found = 0;
-  for (std::size_t i = 0; i < nt; ++i) {
-    const Box& bi = boxes_[i];
-    const std::uint32_t* ti = &tri[3 * bi.triangle];
-    for (std::size_t j = i + 1; j < nt && boxes_[j].lo.x() <= bi.hi.x(); ++j) {
-      const Box& bj = boxes_[j];
-      if (bj.lo.y() > bi.hi.y() || bj.hi.y() < bi.lo.y() || bj.lo.z() > bi.hi.z() || bj.hi.z() < bi.lo.z())
-        continue;
-      const std::uint32_t* tj = &tri[3 * bj.triangle];
-      bool shares = false;
-      for (int a = 0; a < 3 && !shares; ++a)
-        for (int b = 0; b < 3; ++b) shares = shares || ti[a] == tj[b];
-      if (shares) continue;
-      if (trianglesIntersect(x.row(ti[0]), x.row(ti[1]), x.row(ti[2]), x.row(tj[0]), x.row(tj[1]),
-                             x.row(tj[2])))
-        ++found;
+  // Pairs in a cell: a pair whose boxes overlap is tested in the one cell holding the least corner of the
+  // boxes' intersection, the cell (max of the two least cells, axis by axis) both cover. The cell
+  // filters first, then the box and shared-vertex ones together (most pairs that overlap share a vertex).
+  const std::uint32_t total = static_cast<std::uint32_t>(sorted_.size());
+  for (std::uint32_t begin = 0, end = 0; begin < total; begin = end) {
+    const std::uint32_t h = bucketOf(sorted_[begin].key, mask);
+    end = bucketStart_[h];
+    for (std::uint32_t i = begin; i + 1 < end; ++i) {
+      const Candidate& ca = sorted_[i];
+      const std::uint64_t key = ca.key;
+      const std::int32_t cell[3] = {static_cast<std::int32_t>(key >> (2 * kCellBits)),
+                                    static_cast<std::int32_t>(key >> kCellBits & ((1u << kCellBits) - 1)),
+                                    static_cast<std::int32_t>(key & ((1u << kCellBits) - 1))};
+      // a's side of the rule: on each axis, the cell is a's least one or b's must be.
+      const bool a0 = ca.cellLo[0] == cell[0], a1 = ca.cellLo[1] == cell[1], a2 = ca.cellLo[2] == cell[2];
+      for (std::uint32_t j = i + 1; j < end; ++j) {
+        const Candidate& cb = sorted_[j];
+        const bool sameCell = cb.key == key;  // not another cell in the same bucket
+        const bool rule = (a0 | (cb.cellLo[0] == cell[0])) & (a1 | (cb.cellLo[1] == cell[1])) &
+                          (a2 | (cb.cellLo[2] == cell[2]));
+        if (!(sameCell & rule)) continue;
+        const bool overlap = (cb.lo[0] <= ca.hi[0]) & (cb.hi[0] >= ca.lo[0]) & (cb.lo[1] <= ca.hi[1]) &
+                             (cb.hi[1] >= ca.lo[1]) & (cb.lo[2] <= ca.hi[2]) & (cb.hi[2] >= ca.lo[2]);
+        const std::uint32_t *va = ca.vertex, *vb = cb.vertex;
+        const bool apart = (va[0] != vb[0]) & (va[0] != vb[1]) & (va[0] != vb[2]) & (va[1] != vb[0]) &
+                           (va[1] != vb[1]) & (va[1] != vb[2]) & (va[2] != vb[0]) & (va[2] != vb[1]) &
+                           (va[2] != vb[2]);
+        if (sameCell & rule & overlap & apart &&
+            intervalTest(x.row(va[0]), x.row(va[1]), x.row(va[2]), x.row(vb[0]), x.row(vb[1]), x.row(vb[2])))
+          ++found;
+      }
+    }
+  }
+  // Loose triangles against every other (a pair of two loose ones once), without the box test when either
+  // is unboxed: the pair (a < b, as a brute-force loop over i < j would call it) through trianglesIntersect,
+  // or once its boxes are known to overlap, through the interval test it ends with.
+  auto intersect = [&](std::uint32_t a, std::uint32_t b, bool boxesChecked) {
+    const std::uint32_t *ta = &tri[3 * a], *tb = &tri[3 * b];
+    if (shareVertex(ta, tb)) return false;
+    const Vec3 p0 = x.row(ta[0]), p1 = x.row(ta[1]), p2 = x.row(ta[2]);
+    const Vec3 q0 = x.row(tb[0]), q1 = x.row(tb[1]), q2 = x.row(tb[2]);
+    return boxesChecked ? intervalTest(p0, p1, p2, q0, q1, q2) : trianglesIntersect(p0, p1, p2, q0, q1, q2);
+  };
+  for (const std::uint32_t a : loose_) {
+    for (std::uint32_t b = 0; b < nt; ++b) {
+      if (b == a || (isLoose_[b] != kHashed && b < a)) continue;
+      const bool boxed = isLoose_[a] != kUnboxed && isLoose_[b] != kUnboxed;
+      if (boxed && !boxesOverlap(boxes_[a], boxes_[b])) continue;
+      if (intersect(std::min(a, b), std::max(a, b), boxed)) ++found;
     }
   }
   return found;

@@ -32,21 +32,46 @@ float maxPinError(const CapeState& state);
 bool isBlownUp(const Points& positions, const Vec3& centre, float radius = 10.0f);
 
 /// Exact triangle-triangle intersection test (Möller 1997 interval test, evaluated in double precision with
-/// no tolerance; touching counts as intersecting; coplanar triangles are tested in 2D).
+/// no tolerance; touching counts as intersecting; coplanar triangles are tested in 2D). Triangles whose
+/// bounding boxes are apart never intersect: tested first, as the interval test alone reports such pairs as
+/// crossing when a triangle is degenerate (its corners on a line) or the two normals are parallel in double
+/// while rounding puts each triangle across the other's plane.
 bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& q0, const Vec3& q1,
                         const Vec3& q2);
 
-/// Counts pairs of triangles that share no vertex and intersect. Reuses its scratch between calls.
+/// Counts pairs of triangles that share no vertex and intersect: the pairs whose bounding boxes overlap
+/// (closed boxes, as `trianglesIntersect` counts touching) found through a uniform spatial hash, each pair
+/// tested once with the exact test, so the count is the brute-force count over all pairs. Reuses its scratch
+/// between calls (one counter per cape: no allocation once it has seen the cape's size).
 class SelfIntersectionCounter {
  public:
   int count(const Fabric& fabric, const Points& positions);
 
  private:
+  /// A triangle's bounding box and the range of hash cells it covers (inclusive).
   struct Box {
-    Eigen::Vector3f lo, hi;
+    float lo[3], hi[3];
+    std::int32_t cellLo[3], cellHi[3];
+  };
+  /// A triangle in one of the cells it covers.
+  struct Entry {
+    std::uint64_t key;  ///< the cell
+    std::uint32_t triangle, bucket;
+  };
+  /// The same in bucket order, with what the pair loop reads of its triangle.
+  struct Candidate {
+    float lo[3], hi[3];
+    std::int32_t cellLo[3];
+    std::uint32_t vertex[3];
     std::uint32_t triangle;
+    std::uint64_t key;
   };
   std::vector<Box> boxes_;
+  std::vector<Entry> entries_;              ///< in triangle order
+  std::vector<std::uint32_t> bucketStart_;  ///< counting sort of the entries by bucket
+  std::vector<Candidate> sorted_;           ///< the entries bucket by bucket, ascending triangles in each
+  std::vector<std::uint32_t> loose_;   ///< triangles left out of the hash (too many cells, or not finite)
+  std::vector<std::uint8_t> isLoose_;  ///< per triangle: hashed, loose as too large, loose as not finite
 };
 
 /// Per-frame values and run summary of every metric, as the demos report them.
