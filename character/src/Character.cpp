@@ -159,12 +159,91 @@ void Character::placeOnTheGround() {
 
 void Character::advanceTo(double t) {
   gait_.apply(t, mapping_, skeleton_, rootOffset_);
+  moveBodiesTo(t);
+}
+
+void Character::moveBodiesTo(double t) {
   if (t > time_) {
     (void)bodies_->update(t - time_);
   } else {
     bodies_->teleport();
   }
   time_ = t;
+}
+
+Eigen::Isometry3d Character::withOffset(const Eigen::Isometry3d& urdfFramePose) const {
+  // The offset is in the Y-up scene frame (as the gait's root path): into the URDF frame.
+  Eigen::Isometry3d pose = urdfFramePose;
+  pose.translation() += Skeleton::urdfToWorld().transpose() * settings_.offset;
+  return pose;
+}
+
+Status Character::setMotion(double t, const Eigen::Isometry3d& rootLinkPose, const JointPose& joints,
+                            const JointRotations& rotations, MotionFrame frame) {
+  const UrdfModel& model = skeleton_.model();
+  auto fail = [](ErrorCode code, const std::string& what) {
+    return Status::error(code, "Character::setMotion: " + what);
+  };
+  if (!std::isfinite(t)) return fail(ErrorCode::InvalidArgument, "the time is not finite");
+  if (!rootLinkPose.matrix().allFinite()) return fail(ErrorCode::InvalidArgument, "the root pose is not finite");
+  // Everything is checked before anything moves.
+  given_.assign(model.joints().size(), 0);
+  for (const auto& [name, value] : joints) {
+    const int j = model.findJoint(name);
+    if (j < 0) {
+      return fail(ErrorCode::UnknownJoint, "no joint named '" + name + "' in '" + model.name() +
+                                               "' (its movable joints: " + movableJoints(model) + ")");
+    }
+    const JointDesc& joint = model.joints()[static_cast<std::size_t>(j)];
+    if (!joint.isMovable()) {
+      return fail(ErrorCode::NotMovable, "joint '" + name + "' is " + toString(joint.type) +
+                                             " and takes no single value (movable joints of '" + model.name() +
+                                             "': " + movableJoints(model) + ")");
+    }
+    if (!std::isfinite(value)) return fail(ErrorCode::InvalidArgument, "joint '" + name + "': not finite");
+    if (given_[static_cast<std::size_t>(j)]++)
+      return fail(ErrorCode::InvalidArgument, "joint '" + name + "' is given twice");
+  }
+  for (const auto& [name, q] : rotations) {
+    const int j = model.findJoint(name);
+    if (j < 0 || !model.joints()[static_cast<std::size_t>(j)].isSpherical()) {
+      std::string balls;
+      for (const JointDesc& d : model.joints())
+        if (d.isSpherical()) balls += (balls.empty() ? "" : ", ") + d.name;
+      return fail(j < 0 ? ErrorCode::UnknownJoint : ErrorCode::NotMovable,
+                  (j < 0 ? "no joint named '" + name + "'" : "joint '" + name + "' is not spherical") + " in '" +
+                      model.name() + "' (its spherical joints: " + (balls.empty() ? "none" : balls) + ")");
+    }
+    const double n = q.norm();
+    if (!std::isfinite(n) || n < 1e-9)
+      return fail(ErrorCode::InvalidArgument, "joint '" + name + "': not a finite, non-zero quaternion");
+    if (given_[static_cast<std::size_t>(j)]++)
+      return fail(ErrorCode::InvalidArgument, "joint '" + name + "' is given twice");
+  }
+  for (const auto& [name, value] : joints) {
+    const int j = model.findJoint(name);
+    (void)skeleton_.setJointPosition(j, skeleton_.clampToLimits(j, value));
+  }
+  for (const auto& [name, q] : rotations) (void)skeleton_.setJointRotation(model.findJoint(name), q);
+  skeleton_.setRootLinkPose(
+      urdfFrameToWorld(withOffset(rootPoseToUrdfFrame(rootLinkPose, frame, skeleton_)), skeleton_.upAxis()));
+  moveBodiesTo(t);
+  return Status::success();
+}
+
+Status Character::play(const MotionPlayer& player, double t) {
+  if (!std::isfinite(t)) return Status::error(ErrorCode::InvalidArgument, "Character::play: t is not finite");
+  if (player.model().get() != &skeleton_.model())
+    return Status::error(ErrorCode::InvalidArgument, "Character::play: the player is bound to another model");
+  player.sample(t, sampled_);
+  const std::vector<int>& ji = player.jointIndices();
+  for (std::size_t k = 0; k < ji.size(); ++k)
+    (void)skeleton_.setJointPosition(ji[k], skeleton_.clampToLimits(ji[k], sampled_.values[k]));
+  const std::vector<int>& bi = player.ballIndices();
+  for (std::size_t k = 0; k < bi.size(); ++k) (void)skeleton_.setJointRotation(bi[k], sampled_.rotations[k]);
+  skeleton_.setRootLinkPose(urdfFrameToWorld(withOffset(sampled_.root), skeleton_.upAxis()));
+  moveBodiesTo(t);
+  return Status::success();
 }
 
 std::vector<std::string> Character::warnings() const {

@@ -33,6 +33,7 @@ void Skeleton::setUpAxis(UpAxis up) {
 Skeleton::Skeleton(UrdfModelPtr model) : model_(std::move(model)) {
   assert(model_ && "Skeleton needs a loaded UrdfModel");
   q_.assign(model_->joints().size(), 0.0);
+  rotations_.assign(model_->joints().size(), Eigen::Quaterniond::Identity());
   poses_.assign(model_->links().size(), Eigen::Isometry3d::Identity());
   resetJointPositions();
   rebuildShapes();
@@ -78,7 +79,35 @@ double Skeleton::clampToLimits(int joint, double q) const {
 
 void Skeleton::resetJointPositions() {
   for (int j = 0; j < jointCount(); ++j) q_[static_cast<std::size_t>(j)] = restPosition(j);
+  for (Eigen::Quaterniond& r : rotations_) r = Eigen::Quaterniond::Identity();
   dirty_ = true;
+}
+
+Status Skeleton::setJointRotation(const std::string& name, const Eigen::Quaterniond& q) {
+  const int j = jointIndex(name);
+  if (j < 0)
+    return Status::error(ErrorCode::UnknownJoint,
+                         "no joint named '" + name + "' in '" + model_->name() + "'");
+  return setJointRotation(j, q);
+}
+
+Status Skeleton::setJointRotation(int joint, const Eigen::Quaterniond& q) {
+  if (joint < 0 || joint >= jointCount()) {
+    return Status::error(ErrorCode::UnknownJoint, "joint index " + std::to_string(joint) + " out of range");
+  }
+  const JointDesc& j = model_->joints()[static_cast<std::size_t>(joint)];
+  if (!j.isSpherical()) {
+    return Status::error(ErrorCode::NotMovable,
+                         "joint '" + j.name + "' is " + toString(j.type) + " and has no rotation to set");
+  }
+  const double n = q.norm();
+  if (!std::isfinite(n) || n < 1e-9) {
+    return Status::error(ErrorCode::InvalidArgument,
+                         "joint '" + j.name + "': the rotation is not a finite, non-zero quaternion");
+  }
+  rotations_[static_cast<std::size_t>(joint)] = Eigen::Quaterniond(q.coeffs() / n);
+  dirty_ = true;
+  return Status::success();
 }
 
 Status Skeleton::setJointPosition(const std::string& name, double q) {
@@ -134,6 +163,16 @@ void Skeleton::setRootTransform(const Eigen::Isometry3d& root) {
   dirty_ = true;
 }
 
+void Skeleton::setRootLinkPose(const Eigen::Isometry3d& pose) {
+  // linkPose(0) = W * (root rotation * urdfToWorld, root translation), W = sceneToWorld(up).
+  const Eigen::Matrix3d w = sceneToWorld(up_);
+  const Eigen::Quaterniond r(pose.linear());  // orthonormalised through the quaternion
+  Eigen::Isometry3d root = Eigen::Isometry3d::Identity();
+  root.linear() = w.transpose() * r.normalized().toRotationMatrix() * urdfToWorld().transpose();
+  root.translation() = w.transpose() * pose.translation();
+  setRootTransform(root);
+}
+
 void Skeleton::updatePoses() const {
   if (!dirty_) return;
   const auto& links = model_->links();
@@ -158,6 +197,9 @@ void Skeleton::updatePoses() const {
         break;
       case JointType::Prismatic:
         local.translation() += local.linear() * (j.axis * (q * scale_));
+        break;
+      case JointType::Spherical:
+        local.linear() = local.linear() * rotations_[static_cast<std::size_t>(links[l].parentJoint)];
         break;
       default:  // fixed; floating and planar joints are held at their origin
         break;

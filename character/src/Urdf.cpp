@@ -83,6 +83,8 @@ const char* toString(JointType type) {
       return "floating";
     case JointType::Planar:
       return "planar";
+    case JointType::Spherical:
+      return "spherical";
   }
   return "unknown";
 }
@@ -401,6 +403,16 @@ struct UrdfModelBuilder {
     return Status::success();
   }
 
+  // urdfdom read the spherical joints as floating (textForUrdfdom): they are ball joints.
+  static void markSpherical(UrdfModel& model, const std::vector<std::string>& names) {
+    for (const std::string& name : names) {
+      const auto j = model.jointIndex_.find(name);
+      if (j == model.jointIndex_.end()) continue;
+      JointDesc& joint = model.joints_[static_cast<std::size_t>(j->second)];
+      if (joint.type == JointType::Floating) joint.type = JointType::Spherical;
+    }
+  }
+
   // A model that stands along its y axis turned onto z (REP 103), by turning what hangs below the root link
   // (its shapes and its child joints' origins) +90 degrees about x: y -> z, z -> -y, x stays forward.
   static void turnOntoZ(UrdfModel& model) {
@@ -410,6 +422,7 @@ struct UrdfModelBuilder {
       JointDesc& joint = model.joints_[static_cast<std::size_t>(j)];
       joint.origin = turn * joint.origin;
     }
+    model.turnedOntoZ_ = true;
   }
 
   // How many of the legs' joints (hips, knees, ankles) the joint mapping finds by structure alone.
@@ -604,6 +617,7 @@ UrdfLoadResult UrdfModel::fromString(const std::string& xmlIn, const UrdfLoadOpt
   release(parsed);
   if (result.status.ok()) result.status = checkLengths(*model, options.limits.maxLength);
   if (result.status.ok()) {
+    UrdfModelBuilder::markSpherical(*model, sphericalJointNames(outline));
     UrdfModelBuilder::standUp(*model, options.modelUp);
     result.model = std::move(model);
     result.warnings = result.model->warnings();

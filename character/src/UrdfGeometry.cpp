@@ -405,6 +405,18 @@ bool urdfdomName(const std::string& raw, std::string& name) {
   return expandReferences(tidied(raw), name);
 }
 
+std::vector<std::string> sphericalJointNames(const std::vector<XmlElement>& outline) {
+  std::vector<std::string> out;
+  for (const XmlElement& e : outline) {
+    if (e.name != "joint" || e.parent != 0) continue;
+    const std::string* type = e.attribute("type");
+    const std::string* name = e.attribute("name");
+    std::string read;
+    if (type && name && normalised(*type) == "spherical" && urdfdomName(*name, read)) out.push_back(read);
+  }
+  return out;
+}
+
 std::string textForUrdfdom(const std::string& text, const std::vector<XmlElement>& outline,
                            std::vector<std::string>& warnings) {
   std::string out;
@@ -460,7 +472,8 @@ std::string textForUrdfdom(const std::string& text, const std::vector<XmlElement
   if (!spherical.empty()) {
     warnings.push_back(
         "spherical joint(s) " + spherical +
-        " are held at their origin (the gait drives revolute, continuous and prismatic joints)");
+        " are ball joints: the gait holds them at their origin, a motion clip or Character::setMotion turns "
+        "them (Skeleton::setJointRotation)");
   }
   return out;
 }

@@ -46,6 +46,9 @@ bool urdfdomName(const std::string& raw, std::string& name);
 std::string textForUrdfdom(const std::string& text, const std::vector<XmlElement>& outline,
                            std::vector<std::string>& warnings);
 
+/// The names of the <robot>'s joints of type `spherical` (as urdfdom reads names), in file order.
+std::vector<std::string> sphericalJointNames(const std::vector<XmlElement>& outline);
+
 /// A number as Bullet's importer reads it: white space around it allowed, nothing else. False otherwise.
 bool parseUrdfNumber(const std::string& text, double& value);
 

@@ -23,6 +23,7 @@
 #include "cape/character/CharacterBodies.h"
 #include "cape/character/Gait.h"
 #include "cape/character/JointMapping.h"
+#include "cape/character/Motion.h"
 #include "cape/character/Skeleton.h"
 
 #include <memory>
@@ -35,6 +36,8 @@ namespace cape::character {
 
 /// A starting joint configuration: (joint name, position in rad, or m for a prismatic joint) pairs.
 using JointPose = std::vector<std::pair<std::string, double>>;
+/// Rotations of spherical joints by name (see Skeleton::setJointRotation).
+using JointRotations = std::vector<std::pair<std::string, Eigen::Quaterniond>>;
 
 struct CharacterSettings {
   double scale = 1.0;                                ///< uniform scale of the URDF, > 0
@@ -83,6 +86,22 @@ class Character {
   void advanceTo(double t);
   double time() const { return time_; }
 
+  /// The user's own motion at time t (s), from a controller or an animation system, instead of the gait:
+  /// `rootLinkPose` is the URDF root link's pose in `frame` (CharacterSettings::offset added, the automatic
+  /// root height not: the pose is where the root link goes), `joints` positions by name (rad, or m for a
+  /// prismatic joint; clamped to the limits), `rotations` spherical joints' rotations by name. Joints not
+  /// given keep their value. The bodies move there with the velocities of the change since time() (a t not
+  /// after time() is a jump, as for advanceTo), so Bullet's contacts and the cape's sweeps see the motion.
+  /// Errors, with nothing changed: UnknownJoint and NotMovable (the message lists the model's joints of the
+  /// kind), InvalidArgument (t, the pose or a value not finite, a zero quaternion, a joint given twice). No
+  /// allocation once the character has run a frame.
+  Status setMotion(double t, const Eigen::Isometry3d& rootLinkPose, const JointPose& joints = {},
+                   const JointRotations& rotations = {}, MotionFrame frame = MotionFrame::World);
+  /// A clip's pose at time t through a player bound to this character's model (MotionPlayer::create with
+  /// skeleton()), moved as setMotion moves it. InvalidArgument for a player bound to another model or a t
+  /// that is not finite. No allocation once it has run a frame.
+  Status play(const MotionPlayer& player, double t);
+
   Character(const Character&) = delete;  // the bodies point at this skeleton: not copyable, not movable
   Character& operator=(const Character&) = delete;
 
@@ -104,6 +123,8 @@ class Character {
             JointMapping mapping);
   Status applyPose();  // the settings' pose: checked, clamped, into the skeleton and the mapping's neutrals
   void placeOnTheGround();
+  void moveBodiesTo(double t);  // after the skeleton is posed at t
+  Eigen::Isometry3d withOffset(const Eigen::Isometry3d& urdfFramePose) const;
   Skeleton skeleton_;
   Gait gait_;
   CharacterSettings settings_;
@@ -114,6 +135,8 @@ class Character {
   Eigen::Vector3d rootOffset_ = Eigen::Vector3d::Zero();  ///< settings' offset, raised by the root height
   std::vector<std::pair<int, double>> pose_;              ///< joint index, clamped value
   std::vector<std::string> warnings_;
+  std::vector<char> given_;  ///< setMotion: joints named so far in this call
+  MotionPose sampled_;       ///< play: the clip's pose, reused
 };
 
 }  // namespace cape::character

@@ -77,8 +77,19 @@ class Skeleton {
   double restPosition(int joint) const;
   /// q clamped into the joint's limits (unchanged for joints without limits).
   double clampToLimits(int joint, double q) const;
-  /// Every joint back to its rest position.
+  /// Every joint back to its rest position (spherical joints to the identity).
   void resetJointPositions();
+
+  /// A spherical (ball) joint's rotation: the child's joint frame turned by `q` about the joint origin, in
+  /// the joint frame (as PyBullet's resetJointStateMultiDof). `q` is normalised. Errors: UnknownJoint;
+  /// NotMovable (not spherical); InvalidArgument (not finite, or of norm below 1e-9; nothing changes).
+  Status setJointRotation(int joint, const Eigen::Quaterniond& q);
+  Status setJointRotation(const std::string& name, const Eigen::Quaterniond& q);
+  /// The identity for every joint that is not spherical.
+  const Eigen::Quaterniond& jointRotation(int joint) const {
+    assert(joint >= 0 && joint < jointCount() && "joint index out of range");
+    return rotations_[static_cast<std::size_t>(joint)];
+  }
 
   // --- Root
   // ----------------------------------------------------------------------------------------------------
@@ -88,6 +99,10 @@ class Skeleton {
   /// Any rigid character frame (the URDF-to-world rotation is applied inside it).
   void setRootTransform(const Eigen::Isometry3d& root);
   const Eigen::Isometry3d& rootTransform() const { return root_; }
+  /// Puts the URDF root link's frame at `pose` in the world (the frame every pose here is reported in: with
+  /// setUpAxis, Y-up or Z-up), the uniform scale not applied to it: the inverse of linkPose(0). Sets the
+  /// root transform that gives it. A pose whose rotation is not orthonormal is orthonormalised.
+  void setRootLinkPose(const Eigen::Isometry3d& pose);
   /// The world's up axis (Y by default). The root (setRoot, setRootTransform) stays in the Y-up scene frame;
   /// every pose this skeleton reports is turned by sceneToWorld(up) into the world.
   void setUpAxis(UpAxis up);
@@ -117,6 +132,7 @@ class Skeleton {
   UrdfModelPtr model_;
   double scale_ = 1.0;
   std::vector<double> q_;
+  std::vector<Eigen::Quaterniond> rotations_;  ///< per joint; the identity but for spherical joints
   Eigen::Isometry3d root_ = Eigen::Isometry3d::Identity();
   UpAxis up_ = UpAxis::Y;
   std::vector<std::vector<ShapeDesc>> shapes_;    ///< per link, scaled

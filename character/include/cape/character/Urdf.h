@@ -41,7 +41,10 @@ struct ShapeDesc {
   std::string name;  ///< the element's name attribute, or "<link>#<k>" when it has none
 };
 
-enum class JointType : int { Fixed, Revolute, Continuous, Prismatic, Floating, Planar };
+/// Spherical is Bullet's importer's extension (`type="spherical"`, a ball joint: PyBullet's DeepMimic humanoid
+/// has eight); urdfdom has none, so it is read as floating and marked spherical here. Its position is a
+/// rotation (Skeleton::setJointRotation), not a number.
+enum class JointType : int { Fixed, Revolute, Continuous, Prismatic, Floating, Planar, Spherical };
 const char* toString(JointType type);
 
 struct LinkDesc {
@@ -65,7 +68,9 @@ struct JointDesc {
   double upper = 0.0;
   double maxVelocity = 0.0;  ///< rad/s or m/s, as written in <limit velocity=...>; 0 when absent
 
-  /// One scalar position (revolute, continuous, prismatic); fixed, floating and planar joints have none.
+  /// One scalar position (revolute, continuous, prismatic); fixed, floating, planar and spherical joints have
+  /// none (a spherical joint's position is a rotation: isSpherical).
+  bool isSpherical() const { return type == JointType::Spherical; }
   bool isMovable() const {
     return type == JointType::Revolute || type == JointType::Continuous || type == JointType::Prismatic;
   }
@@ -167,9 +172,14 @@ class UrdfModel {
   /// Things that loaded but not as written: mesh elements left out, geometry urdfdom could not read, ... Each
   /// names its link.
   const std::vector<std::string>& warnings() const { return warnings_; }
+  /// True when the model stood along y in its file and was turned onto z (UrdfLoadOptions::modelUp): what
+  /// hangs below the root link was turned +90 degrees about x. A motion written for the file's Y-up frame
+  /// (MotionFrame::YUp) is turned the same way.
+  bool turnedOntoZ() const { return turnedOntoZ_; }
 
  private:
   friend struct UrdfModelBuilder;
+  bool turnedOntoZ_ = false;
   std::string name_;
   std::vector<LinkDesc> links_;
   std::vector<JointDesc> joints_;
