@@ -1,0 +1,1 @@
+// MotionBvh: being written.

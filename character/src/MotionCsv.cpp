@@ -1,0 +1,1 @@
+// MotionCsv: being written.

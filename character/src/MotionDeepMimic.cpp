@@ -1,0 +1,1 @@
+// MotionDeepMimic: being written.

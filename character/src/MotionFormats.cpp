@@ -1,0 +1,1 @@
+// MotionFormats: being written.

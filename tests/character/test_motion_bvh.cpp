@@ -1,0 +1,1 @@
+// test_motion_bvh: being written.

@@ -1,0 +1,1 @@
+// test_motion_csv_deepmimic: being written.
