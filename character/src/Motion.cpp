@@ -206,6 +206,15 @@ Status MotionPlayer::create(const MotionClip& clip, const Skeleton& skeleton, co
   }
   for (Eigen::Quaterniond& q : c.rotations) q.normalize();
   c.frame = MotionFrame::Urdf;
+  if (settings.alignHeading) {
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(-headingAboutZ(c.rootRotations.front()),
+                                                    Eigen::Vector3d::UnitZ()));
+    const Eigen::Vector3d pivot(c.rootPositions.front().x(), c.rootPositions.front().y(), 0.0);
+    for (std::size_t k = 0; k < c.times.size(); ++k) {
+      c.rootPositions[k] = pivot + turn * (c.rootPositions[k] - pivot);
+      c.rootRotations[k] = (turn * c.rootRotations[k]).normalized();
+    }
+  }
 
   // The loop's displacement: the first sample's horizontal place and heading onto the last's.
   const Eigen::Vector3d first(c.rootPositions.front().x(), c.rootPositions.front().y(), 0.0);

@@ -75,6 +75,9 @@ struct PlaybackSettings {
   /// then walks off from where it was put, plus CharacterSettings::offset). Off: the clip's positions as
   /// written.
   bool startAtOrigin = true;
+  /// Turns the whole clip about the up axis through its first root so that it starts facing +x in the URDF
+  /// frame (the way a character at yaw 0 faces: where its cape is put). Off: the clip's headings as written.
+  bool alignHeading = true;
 };
 
 /// One sampled pose, bound to a skeleton: the root link's pose in the URDF frame and the bound joints'
