@@ -185,7 +185,8 @@ Status Character::setMotion(double t, const Eigen::Isometry3d& rootLinkPose, con
     return Status::error(code, "Character::setMotion: " + what);
   };
   if (!std::isfinite(t)) return fail(ErrorCode::InvalidArgument, "the time is not finite");
-  if (!rootLinkPose.matrix().allFinite()) return fail(ErrorCode::InvalidArgument, "the root pose is not finite");
+  if (!rootLinkPose.matrix().allFinite())
+    return fail(ErrorCode::InvalidArgument, "the root pose is not finite");
   // Everything is checked before anything moves.
   given_.assign(model.joints().size(), 0);
   for (const auto& [name, value] : joints) {
@@ -197,8 +198,8 @@ Status Character::setMotion(double t, const Eigen::Isometry3d& rootLinkPose, con
     const JointDesc& joint = model.joints()[static_cast<std::size_t>(j)];
     if (!joint.isMovable()) {
       return fail(ErrorCode::NotMovable, "joint '" + name + "' is " + toString(joint.type) +
-                                             " and takes no single value (movable joints of '" + model.name() +
-                                             "': " + movableJoints(model) + ")");
+                                             " and takes no single value (movable joints of '" +
+                                             model.name() + "': " + movableJoints(model) + ")");
     }
     if (!std::isfinite(value)) return fail(ErrorCode::InvalidArgument, "joint '" + name + "': not finite");
     if (given_[static_cast<std::size_t>(j)]++)
@@ -211,8 +212,9 @@ Status Character::setMotion(double t, const Eigen::Isometry3d& rootLinkPose, con
       for (const JointDesc& d : model.joints())
         if (d.isSpherical()) balls += (balls.empty() ? "" : ", ") + d.name;
       return fail(j < 0 ? ErrorCode::UnknownJoint : ErrorCode::NotMovable,
-                  (j < 0 ? "no joint named '" + name + "'" : "joint '" + name + "' is not spherical") + " in '" +
-                      model.name() + "' (its spherical joints: " + (balls.empty() ? "none" : balls) + ")");
+                  (j < 0 ? "no joint named '" + name + "'" : "joint '" + name + "' is not spherical") +
+                      " in '" + model.name() +
+                      "' (its spherical joints: " + (balls.empty() ? "none" : balls) + ")");
     }
     const double n = q.norm();
     if (!std::isfinite(n) || n < 1e-9)

@@ -22,8 +22,7 @@ bool unitish(const Eigen::Quaterniond& q) {
 }
 
 Status bad(const MotionClip& clip, const std::string& what) {
-  return Status::error(ErrorCode::InvalidArgument,
-                       "motion clip '" + clip.name + "': " + what);
+  return Status::error(ErrorCode::InvalidArgument, "motion clip '" + clip.name + "': " + what);
 }
 
 // The (+90 degree about x) turn taking a Y-up tool's axes (x forward, y up, z right) onto the URDF's.
@@ -142,8 +141,8 @@ Eigen::Isometry3d urdfFrameToWorld(const Eigen::Isometry3d& pose, UpAxis up) {
   return out;
 }
 
-Status MotionPlayer::create(const MotionClip& clip, const Skeleton& skeleton, const PlaybackSettings& settings,
-                            MotionPlayer& out) {
+Status MotionPlayer::create(const MotionClip& clip, const Skeleton& skeleton,
+                            const PlaybackSettings& settings, MotionPlayer& out) {
   Status s = clip.check();
   if (!s.ok()) return s;
   if (!std::isfinite(settings.speed) || settings.speed <= 0.0) {
@@ -159,30 +158,30 @@ Status MotionPlayer::create(const MotionClip& clip, const Skeleton& skeleton, co
   for (const std::string& name : clip.joints) {
     const int j = model.findJoint(name);
     if (j < 0) {
-      return Status::error(ErrorCode::UnknownJoint, "motion clip '" + clip.name + "': no joint named '" + name +
-                                                        "' in '" + model.name() + "' (its movable joints: " +
-                                                        jointsOfKind(model, false) + ")");
+      return Status::error(ErrorCode::UnknownJoint,
+                           "motion clip '" + clip.name + "': no joint named '" + name + "' in '" +
+                               model.name() + "' (its movable joints: " + jointsOfKind(model, false) + ")");
     }
     const JointDesc& joint = model.joints()[static_cast<std::size_t>(j)];
     if (!joint.isMovable()) {
-      return Status::error(ErrorCode::NotMovable, "motion clip '" + clip.name + "': joint '" + name + "' is " +
-                                                      toString(joint.type) +
-                                                      " and takes no single value (movable joints of '" +
-                                                      model.name() + "': " + jointsOfKind(model, false) + ")");
+      return Status::error(ErrorCode::NotMovable,
+                           "motion clip '" + clip.name + "': joint '" + name + "' is " +
+                               toString(joint.type) + " and takes no single value (movable joints of '" +
+                               model.name() + "': " + jointsOfKind(model, false) + ")");
     }
     p.jointIndex_.push_back(j);
   }
   for (const std::string& name : clip.balls) {
     const int j = model.findJoint(name);
     if (j < 0) {
-      return Status::error(ErrorCode::UnknownJoint, "motion clip '" + clip.name + "': no joint named '" + name +
-                                                        "' in '" + model.name() + "' (its spherical joints: " +
-                                                        jointsOfKind(model, true) + ")");
+      return Status::error(ErrorCode::UnknownJoint,
+                           "motion clip '" + clip.name + "': no joint named '" + name + "' in '" +
+                               model.name() + "' (its spherical joints: " + jointsOfKind(model, true) + ")");
     }
     const JointDesc& joint = model.joints()[static_cast<std::size_t>(j)];
     if (!joint.isSpherical()) {
-      return Status::error(ErrorCode::NotMovable, "motion clip '" + clip.name + "': joint '" + name + "' is " +
-                                                      toString(joint.type) +
+      return Status::error(ErrorCode::NotMovable, "motion clip '" + clip.name + "': joint '" + name +
+                                                      "' is " + toString(joint.type) +
                                                       ", not spherical, and takes no rotation (spherical "
                                                       "joints of '" +
                                                       model.name() + "': " + jointsOfKind(model, true) + ")");
@@ -207,8 +206,8 @@ Status MotionPlayer::create(const MotionClip& clip, const Skeleton& skeleton, co
   for (Eigen::Quaterniond& q : c.rotations) q.normalize();
   c.frame = MotionFrame::Urdf;
   if (settings.alignHeading) {
-    const Eigen::Quaterniond turn(Eigen::AngleAxisd(-headingAboutZ(c.rootRotations.front()),
-                                                    Eigen::Vector3d::UnitZ()));
+    const Eigen::Quaterniond turn(
+        Eigen::AngleAxisd(-headingAboutZ(c.rootRotations.front()), Eigen::Vector3d::UnitZ()));
     const Eigen::Vector3d pivot(c.rootPositions.front().x(), c.rootPositions.front().y(), 0.0);
     for (std::size_t k = 0; k < c.times.size(); ++k) {
       c.rootPositions[k] = pivot + turn * (c.rootPositions[k] - pivot);

@@ -22,7 +22,9 @@ UrdfModelPtr humanoid() {
   return r.model;
 }
 
-Eigen::Quaterniond aboutZ(double a) { return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ())); }
+Eigen::Quaterniond aboutZ(double a) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()));
+}
 
 // A walk-like clip of the shipped humanoid: forward along +x at `speed`, knees on a sine of period T,
 // n + 1 samples over one period (the last equal to the first but for the root's advance).
@@ -240,8 +242,7 @@ TEST(MotionFrames, SphericalJointsAndAYUpRootLandWhereTheFilesWorldSays) {
   const Eigen::Quaterniond R(Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.2, 1.0, 0.1).normalized()));
   const Eigen::Quaterniond q(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 0.3, -0.5).normalized()));
   const double e = 0.9;
-  const Eigen::Vector3d handInFile =
-      p + R * (Eigen::Vector3d(0, 1, 0) + q * (Eigen::Vector3d(0.5, 0, 0)));
+  const Eigen::Vector3d handInFile = p + R * (Eigen::Vector3d(0, 1, 0) + q * (Eigen::Vector3d(0.5, 0, 0)));
   const Eigen::Vector3d expected = Eigen::AngleAxisd(0.5 * kPi, Eigen::Vector3d::UnitX()) * handInFile;
   (void)e;
   for (UrdfLoadOptions::Up up : {UrdfLoadOptions::Up::Y, UrdfLoadOptions::Up::Z}) {
@@ -290,7 +291,8 @@ TEST(MotionFrames, WorldUrdfAndBothUpAxesAgree) {
   }
   EXPECT_LT((z.linkPose(0).matrix() - root.matrix()).norm(), 1e-12);
   // A World pose in a Y-up world is the URDF pose turned by urdfToWorld.
-  const Eigen::Isometry3d back = rootPoseToUrdfFrame(urdfFrameToWorld(root, UpAxis::Y), MotionFrame::World, y);
+  const Eigen::Isometry3d back =
+      rootPoseToUrdfFrame(urdfFrameToWorld(root, UpAxis::Y), MotionFrame::World, y);
   EXPECT_LT((back.matrix() - root.matrix()).norm(), 1e-12);
 }
 
@@ -315,7 +317,8 @@ TEST(CharacterMotion, SetMotionMovesTheBodiesWithTheVelocitiesOfTheirPoses) {
     const double dt = 1.0 / 60.0;
     root.translation() = Eigen::Vector3d(0.03, 0.01, 0.002);
     root.linear() = aboutZ(0.05).toRotationMatrix();
-    ASSERT_TRUE(c.setMotion(dt, root, {{"left_knee", 0.35}, {"left_hip_pitch", 0.1}}, {}, MotionFrame::Urdf).ok());
+    ASSERT_TRUE(
+        c.setMotion(dt, root, {{"left_knee", 0.35}, {"left_hip_pitch", 0.1}}, {}, MotionFrame::Urdf).ok());
     const btTransform after = body->getWorldTransform();
     btVector3 v, wv;
     btTransformUtil::calculateVelocity(before, after, btScalar(dt), v, wv);
@@ -347,7 +350,8 @@ TEST(CharacterMotion, ErrorsListTheJointsAndChangeNothing) {
   EXPECT_NE(s.message().find("tail"), std::string::npos);
   EXPECT_NE(s.message().find("right_hip_pitch"), std::string::npos) << s.message();
   EXPECT_EQ(c.setMotion(0.1, moved, {{"pelvis_joint", 1.0}}).code(), ErrorCode::NotMovable);
-  EXPECT_EQ(c.setMotion(0.1, moved, {{"left_knee", 1.0}, {"left_knee", 0.5}}).code(), ErrorCode::InvalidArgument);
+  EXPECT_EQ(c.setMotion(0.1, moved, {{"left_knee", 1.0}, {"left_knee", 0.5}}).code(),
+            ErrorCode::InvalidArgument);
   EXPECT_EQ(c.setMotion(0.1, moved, {{"left_knee", std::nan("")}}).code(), ErrorCode::InvalidArgument);
   EXPECT_EQ(c.setMotion(0.1, moved, {}, {{"left_knee", Eigen::Quaterniond::Identity()}}).code(),
             ErrorCode::NotMovable);

@@ -38,16 +38,16 @@ const char* toString(MotionFrame frame);
 
 /// Samples of a motion: times, the root link's pose and named joints' positions at each.
 struct MotionClip {
-  std::string name;                                   ///< where it came from (file name), for messages
-  MotionFrame frame = MotionFrame::Urdf;              ///< the frame of rootPositions and rootRotations
-  std::vector<double> times;                          ///< s, strictly increasing, times[0] >= 0
-  std::vector<Eigen::Vector3d> rootPositions;         ///< m, one per sample
-  std::vector<Eigen::Quaterniond> rootRotations;      ///< unit, one per sample
-  std::vector<std::string> joints;                    ///< scalar joints (revolute, continuous, prismatic)
-  std::vector<double> values;                         ///< rad or m, sample-major: values[s * joints + j]
-  std::vector<std::string> balls;                     ///< spherical joints
-  std::vector<Eigen::Quaterniond> rotations;          ///< unit, sample-major: rotations[s * balls + b]
-  bool loop = true;                                   ///< what the file says (DeepMimic "Loop")
+  std::string name;                               ///< where it came from (file name), for messages
+  MotionFrame frame = MotionFrame::Urdf;          ///< the frame of rootPositions and rootRotations
+  std::vector<double> times;                      ///< s, strictly increasing, times[0] >= 0
+  std::vector<Eigen::Vector3d> rootPositions;     ///< m, one per sample
+  std::vector<Eigen::Quaterniond> rootRotations;  ///< unit, one per sample
+  std::vector<std::string> joints;                ///< scalar joints (revolute, continuous, prismatic)
+  std::vector<double> values;                     ///< rad or m, sample-major: values[s * joints + j]
+  std::vector<std::string> balls;                 ///< spherical joints
+  std::vector<Eigen::Quaterniond> rotations;      ///< unit, sample-major: rotations[s * balls + b]
+  bool loop = true;                               ///< what the file says (DeepMimic "Loop")
 
   int sampleCount() const { return static_cast<int>(times.size()); }
   /// s: times.back() - times.front() (0 for fewer than two samples).
@@ -119,8 +119,8 @@ class MotionPlayer {
   PlaybackSettings settings_;
   std::vector<int> jointIndex_, ballIndex_;
   Eigen::Isometry3d loopStep_ = Eigen::Isometry3d::Identity();  ///< D: last sample's pose from the first's
-  double loopYaw_ = 0.0;                                         ///< rad, D's turn about z
-  Eigen::Vector3d shift_ = Eigen::Vector3d::Zero();  ///< startAtOrigin's horizontal move
+  double loopYaw_ = 0.0;                                        ///< rad, D's turn about z
+  Eigen::Vector3d shift_ = Eigen::Vector3d::Zero();             ///< startAtOrigin's horizontal move
 };
 
 /// A root link pose given in `frame` as a pose in the URDF frame, for `skeleton` (its up axis for World, its

@@ -41,9 +41,9 @@ struct ShapeDesc {
   std::string name;  ///< the element's name attribute, or "<link>#<k>" when it has none
 };
 
-/// Spherical is Bullet's importer's extension (`type="spherical"`, a ball joint: PyBullet's DeepMimic humanoid
-/// has eight); urdfdom has none, so it is read as floating and marked spherical here. Its position is a
-/// rotation (Skeleton::setJointRotation), not a number.
+/// Spherical is Bullet's importer's extension (`type="spherical"`, a ball joint: PyBullet's DeepMimic
+/// humanoid has eight); urdfdom has none, so it is read as floating and marked spherical here. Its position
+/// is a rotation (Skeleton::setJointRotation), not a number.
 enum class JointType : int { Fixed, Revolute, Continuous, Prismatic, Floating, Planar, Spherical };
 const char* toString(JointType type);
 
