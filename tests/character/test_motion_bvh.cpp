@@ -741,6 +741,68 @@ TEST(Bvh, UnmatchedRolesAreSaid) {
   EXPECT_EQ(r.clip.joints.size(), 6u);  // hips, knees, ankles
 }
 
+// --- compound joints
+// ----------------------------------------------------------------------------------------
+
+/// The humanoid with its left hip made of three hinges in series at one point: yaw (z), roll (x), pitch (-y).
+UrdfModelPtr humanoidWithBallHip() {
+  std::string text = UrdfModel::humanoidUrdf();
+  const std::size_t from = text.find("<joint name=\"left_hip_pitch\"");
+  const std::size_t to = text.find("</joint>", from) + 8;
+  const auto hinge = [](const std::string& name, const std::string& parent, const std::string& child,
+                        const std::string& origin, const std::string& axis, const std::string& limits) {
+    return "<joint name=\"" + name + "\" type=\"revolute\"><parent link=\"" + parent + "\"/><child link=\"" +
+           child + "\"/><origin xyz=\"" + origin + "\" rpy=\"0 0 0\"/><axis xyz=\"" + axis + "\"/><limit " +
+           limits + " effort=\"200\" velocity=\"8\"/></joint>\n";
+  };
+  const std::string wide = "lower=\"-1.5\" upper=\"1.5\"";
+  text.replace(from, to - from,
+               hinge("left_hip_yaw", "pelvis", "left_hip_yaw_link", "0 0.10 0", "0 0 1", wide) +
+                   "<link name=\"left_hip_yaw_link\"/>\n" +
+                   hinge("left_hip_roll", "left_hip_yaw_link", "left_hip_roll_link", "0 0 0", "1 0 0", wide) +
+                   "<link name=\"left_hip_roll_link\"/>\n" +
+                   hinge("left_hip_pitch", "left_hip_roll_link", "left_thigh", "0 0 0", "0 -1 0",
+                         "lower=\"-0.8\" upper=\"1.6\""));
+  const UrdfLoadResult r = UrdfModel::fromString(text);
+  EXPECT_TRUE(r.ok()) << r.status.message();
+  return r.model;
+}
+
+TEST(Bvh, HingesInSeriesTakeAnyThighRotationTogether) {
+  const UrdfModelPtr model = humanoidWithBallHip();
+  ASSERT_TRUE(model);
+  std::vector<Bone> bones = humanoidBones();
+  for (Bone& b : bones)
+    if (b.name == "LeftUpLeg") b.order = "YZX";  // BVH Y is URDF z (yaw), Z is x (roll), X is y (pitch)
+  std::vector<Frame> frames = knownFrames();
+  const double ypr[4][3] = {{0.0, 0.0, 0.0}, {0.3, 0.2, 0.5}, {-0.6, -0.4, 1.2}, {1.0, 0.5, -0.5}};
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    frames[k].angles.erase("left_hip_pitch");
+    frames[k].turns["LeftUpLeg"] = {{Eigen::Vector3d::UnitZ(), ypr[k][0]},
+                                    {Eigen::Vector3d::UnitX(), ypr[k][1]},
+                                    {-Eigen::Vector3d::UnitY(), ypr[k][2]}};
+  }
+  const MotionClipResult r = retarget(writeBvh(bones, frames, {yUpAxes(), 0.01, {}}), {}, model);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.clip.joints.size(), 14u);
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const int at = static_cast<int>(k);
+    EXPECT_NEAR(valueOf(r.clip, "left_hip_yaw", at), ypr[k][0], 1e-6) << k;
+    EXPECT_NEAR(valueOf(r.clip, "left_hip_roll", at), ypr[k][1], 1e-6) << k;
+    EXPECT_NEAR(valueOf(r.clip, "left_hip_pitch", at), ypr[k][2], 1e-6) << k;
+    Skeleton want(model);
+    want.setUpAxis(UpAxis::Z);
+    want.setRootLinkPose(expectedRoot(frames[k]));
+    for (const auto& [joint, q] : frames[k].angles) ASSERT_TRUE(want.setJointPosition(joint, q).ok());
+    ASSERT_TRUE(want.setJointPosition("left_hip_yaw", ypr[k][0]).ok());
+    ASSERT_TRUE(want.setJointPosition("left_hip_roll", ypr[k][1]).ok());
+    ASSERT_TRUE(want.setJointPosition("left_hip_pitch", ypr[k][2]).ok());
+    const std::vector<Eigen::Vector3d> a = landmarks(want), b = landmarks(posed(model, r.clip, at));
+    for (std::size_t i = 0; i < a.size(); ++i)
+      EXPECT_LT((a[i] - b[i]).norm(), 1e-6) << "frame " << k << " " << i;
+  }
+}
+
 // --- (6) malformed files -----------------------------------------------------------------------------------
 
 std::string goodText() {
@@ -878,6 +940,73 @@ TEST(Bvh, FilesAreReadWithTheirSizeChecked) {
   const MotionClipResult noModel = parseBvh(goodText(), nullptr);
   EXPECT_EQ(noModel.status.code(), ErrorCode::InvalidArgument);
   std::filesystem::remove_all(dir);
+}
+
+TEST(Bvh, ARootAboveTheHipsCarriesTheMotion) {
+  // Exporters often put a "Reference" joint above the hips: it has the position and rotation channels here,
+  // the hips (at the same point) only rotations that stay zero.
+  std::vector<Bone> bones = humanoidBones();
+  for (Bone& b : bones) b.parent = b.parent < 0 ? 0 : b.parent + 1;
+  Bone reference = bones[0];
+  reference.name = "Reference";
+  reference.parent = -1;
+  bones.insert(bones.begin(), reference);
+  const std::vector<Frame> frames = knownFrames();
+  const MotionClipResult r = retarget(writeBvh(bones, frames, {yUpAxes(), 0.01, {}}));
+  ASSERT_TRUE(r.ok());
+  expectSameClip(r.clip, retarget(writeBvh(humanoidBones(), frames, {yUpAxes(), 0.01, {}})).clip);
+}
+
+TEST(Bvh, BadOptionsAreRefused) {
+  BvhOptions negative;
+  negative.scale = -0.01;
+  EXPECT_EQ(parseBvh(goodText(), humanoid(), negative).status.code(), ErrorCode::InvalidArgument);
+  BvhOptions nan;
+  nan.scale = NAN;
+  EXPECT_EQ(parseBvh(goodText(), humanoid(), nan).status.code(), ErrorCode::InvalidArgument);
+  EXPECT_EQ(parseBvh(goodText(), humanoid(), {}, nullptr, 0.0).status.code(), ErrorCode::InvalidArgument);
+  BvhOptions zeroLimit;
+  zeroLimit.limits.maxDepth = 0;
+  EXPECT_EQ(parseBvh(goodText(), humanoid(), zeroLimit).status.code(), ErrorCode::InvalidArgument);
+}
+
+TEST(Bvh, CorruptedFilesNeverCrash) {
+  // Deterministic corruptions of a good file (cuts, repeats, stray characters): each is read or refused.
+  const std::string good = goodText();
+  const std::string junk = "{}\n \t-.0123456789eE+nanifJOINTEnd SiteOFFSETCHANNELS 6 Xrotation:";
+  unsigned state = 12345u;
+  const auto next = [&](std::size_t n) {
+    state = state * 1103515245u + 12345u;
+    return static_cast<std::size_t>((state >> 8) % n);
+  };
+  int read = 0, refused = 0;
+  for (int i = 0; i < 300; ++i) {
+    std::string text = good;
+    for (int edits = 1 + static_cast<int>(next(4)); edits > 0; --edits) {
+      const std::size_t at = next(text.size()), len = 1 + next(40);
+      switch (next(3)) {
+        case 0:
+          text.erase(at, len);
+          break;
+        case 1:
+          text.insert(at, text.substr(next(text.size()), len));
+          break;
+        default:
+          for (std::size_t k = at; k < std::min(text.size(), at + len); k += 1 + next(8))
+            text[k] = junk[next(junk.size())];
+      }
+    }
+    const MotionClipResult r = parseBvh(text, humanoid(), {}, nullptr, 1.0, "bad.bvh");
+    if (r.ok()) {
+      ++read;
+      EXPECT_TRUE(r.clip.check().ok());
+    } else {
+      ++refused;
+      EXPECT_FALSE(r.status.message().empty());
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_EQ(read + refused, 300);
 }
 
 // --- (7) a humanoid of ball joints ------------------------------------------------------------------------
