@@ -9,6 +9,7 @@
 // (the shortest turn taking the URDF bone's zero-pose direction onto the BVH bone's rest direction), and its
 // joints take what of that they can, relative to their parent's already retargeted rotation.
 #include "BvhRoles.h"
+#include "MotionText.h"
 #include "cape/character/MotionFormats.h"
 
 #include <algorithm>
@@ -1407,34 +1408,9 @@ MotionClipResult parseBvh(const std::string& text, const UrdfModelPtr& model, co
 MotionClipResult readBvh(const std::string& path, const UrdfModelPtr& model, const BvhOptions& options,
                          const JointMapping* mapping, double characterScale) {
   MotionClipResult result;
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    result.status =
-        Status::error(ErrorCode::FileNotFound, "BVH file '" + path + "' does not exist or is not a file");
-    return result;
-  }
-  // The size is checked before reading, and no more than one byte past the limit is read (the file may grow,
-  // or a special file report no size).
-  const std::size_t limit = options.limits.maxFileBytes;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (!ec && size > limit) {
-    result.status = Status::error(ErrorCode::InvalidArgument,
-                                  path + ": " + std::to_string(size) + " bytes; the limit is " +
-                                      std::to_string(limit) + " (MotionLimits::maxFileBytes)");
-    return result;
-  }
-  std::ifstream in(path, std::ios::binary);
   std::string text;
-  char chunk[65536];
-  while (in && text.size() <= limit) {
-    in.read(chunk,
-            static_cast<std::streamsize>(std::min<std::size_t>(sizeof chunk, limit + 1 - text.size())));
-    text.append(chunk, static_cast<std::size_t>(in.gcount()));
-  }
-  if (!in && !in.eof()) {
-    result.status = Status::error(ErrorCode::FileNotFound, "BVH file '" + path + "' cannot be read");
-    return result;
-  }
+  result.status = motiontext::readTextFile(path, options.limits.maxFileBytes, text);
+  if (!result.status.ok()) return result;
   return parse(text, model, options, mapping, characterScale, path,
                std::filesystem::path(path).filename().string());
 }
