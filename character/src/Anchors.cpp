@@ -2,6 +2,7 @@
 #include "cape/character/Anchors.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 
@@ -84,6 +85,41 @@ void finish(const Character& c, const Frame& f, ShoulderAnchors& a) {
   a.back = backBehind(c, f, a.upperTorsoLink, 0.5 * (a.left + a.right));
 }
 
+// The cape pinned where two shoulder joints turn from (their chains' first joints' parent links), at
+// their centres; false when either has no link with a body.
+bool anchorsAtJoints(const Character& c, const Frame& f, const int (&joints)[2], bool chains,
+                     const std::string& how, ShoulderAnchors& a) {
+  const Skeleton& sk = c.skeleton();
+  const UrdfModel& m = sk.model();
+  int links[2];
+  Eigen::Vector3d points[2];
+  for (int side = 0; side < 2; ++side) {
+    const int start = chains ? chainStart(m, joints[side]) : joints[side];
+    const JointDesc& j = m.joints()[static_cast<std::size_t>(start)];
+    links[side] = withBody(c, j.parentLink);
+    points[side] = f.local(sk.linkPose(j.childLink).translation());  // the joint's centre
+  }
+  if (links[0] < 0 || links[1] < 0) return false;
+  a.leftLink = links[0];
+  a.rightLink = links[1];
+  a.left = points[0];
+  a.right = points[1];
+  finish(c, f, a);
+  const std::string where = a.leftLink == a.rightLink ? "link '" + linkName(m, a.leftLink) + "'"
+                                                      : "links '" + linkName(m, a.leftLink) + "' and '" +
+                                                            linkName(m, a.rightLink) + "'";
+  a.description = "cape pinned to " + where + " (" + how + ": joints '" +
+                  m.joints()[static_cast<std::size_t>(joints[0])].name + "' and '" +
+                  m.joints()[static_cast<std::size_t>(joints[1])].name + "')";
+  return true;
+}
+
+bool namedLikeShoulder(const std::string& name) {
+  std::string lower = name;
+  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return lower.find("shoulder") != std::string::npos;
+}
+
 }  // namespace
 
 ShoulderAnchors findShoulderAnchors(const Character& c) {
@@ -93,30 +129,30 @@ ShoulderAnchors findShoulderAnchors(const Character& c) {
   const Frame f = characterFrame(sk);
   const int roles[2] = {c.mapping()[GaitRole::LeftShoulder].joint,
                         c.mapping()[GaitRole::RightShoulder].joint};
-  if (roles[0] >= 0 && roles[1] >= 0) {
-    int links[2];
-    Eigen::Vector3d points[2];
-    for (int side = 0; side < 2; ++side) {
-      const int start = chainStart(m, roles[side]);
-      const JointDesc& j = m.joints()[static_cast<std::size_t>(start)];
-      links[side] = withBody(c, j.parentLink);
-      points[side] = f.local(sk.linkPose(j.childLink).translation());  // the joint's centre
+  if (roles[0] >= 0 && roles[1] >= 0 &&
+      anchorsAtJoints(c, f, roles, true, "the shoulders of the joint mapping", a))
+    return a;
+  // Ball shoulders (spherical joints named like a shoulder, as PyBullet's DeepMimic humanoid has): the
+  // gait's mapping holds only hinges, and the links named "shoulder" there are the upper arms, which swing.
+  // The cape pins to the link the balls turn from (the chest), at the two farthest apart sideways.
+  int balls[2] = {-1, -1};
+  double side[2] = {0.0, 0.0};
+  for (int j = 0; j < static_cast<int>(m.joints().size()); ++j) {
+    const JointDesc& joint = m.joints()[static_cast<std::size_t>(j)];
+    if (joint.type != JointType::Spherical || !namedLikeShoulder(joint.name)) continue;
+    const double x = f.local(sk.linkPose(joint.childLink).translation()).x();
+    if (balls[0] < 0 || x < side[0]) {
+      balls[0] = j;
+      side[0] = x;
     }
-    if (links[0] >= 0 && links[1] >= 0) {
-      a.leftLink = links[0];
-      a.rightLink = links[1];
-      a.left = points[0];
-      a.right = points[1];
-      finish(c, f, a);
-      const std::string where = a.leftLink == a.rightLink ? "link '" + linkName(m, a.leftLink) + "'"
-                                                          : "links '" + linkName(m, a.leftLink) + "' and '" +
-                                                                linkName(m, a.rightLink) + "'";
-      a.description = "cape pinned to " + where + " (the shoulders of the joint mapping: joints '" +
-                      m.joints()[static_cast<std::size_t>(roles[0])].name + "' and '" +
-                      m.joints()[static_cast<std::size_t>(roles[1])].name + "')";
-      return a;
+    if (balls[1] < 0 || x > side[1]) {
+      balls[1] = j;
+      side[1] = x;
     }
   }
+  if (balls[0] >= 0 && balls[1] >= 0 && balls[0] != balls[1] &&
+      anchorsAtJoints(c, f, balls, false, "ball joints named like \"shoulder\"", a))
+    return a;
   const std::vector<std::string> named = m.linksContaining("shoulder");
   if (named.empty()) {
     a.status =

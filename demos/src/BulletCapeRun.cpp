@@ -107,6 +107,7 @@ class BulletCapeRun final : public SceneRun {
   }
   double lastFrameTimeUs() const override { return frameUs_; }
   double lastCapeTimeUs() const override { return capeUs_; }
+  double lastMotionTimeUs() const override { return scene_->lastMotionTimeUs(); }
   int worldObjectCount() const override { return scene_->world().getNumCollisionObjects(); }
   std::string describe() const override { return scene_->describe(); }
   Vec3 up() const override { return scene_->up(); }

@@ -178,6 +178,16 @@ bool BulletScene::loadModel(const RunOptions& o, std::string& error) {
     return false;
   }
   model_ = loaded.model;
+  if (!o.motion.empty()) {
+    character::MotionClipResult clip =
+        character::loadMotion(o.motion, model_, o.motionLoad, nullptr, o.scale);
+    warnings_.insert(warnings_.end(), clip.warnings.begin(), clip.warnings.end());
+    if (!clip.ok()) {
+      error = clip.status.message();
+      return false;
+    }
+    clip_ = std::move(clip.clip);
+  }
   body_ = (o.urdf.empty() ? std::string("the shipped humanoid (character/models/humanoid.urdf)")
                           : "URDF " + o.urdf);
   return true;
@@ -215,6 +225,29 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
     return false;
   }
   c->urdf = std::move(made.character);
+  if (!options_.motion.empty()) {
+    // One player serves every character (they share the model); each starts in the clip's first pose.
+    if (!player_) {
+      player_ = std::make_unique<character::MotionPlayer>();
+      const character::Status bound =
+          character::MotionPlayer::create(clip_, c->urdf->skeleton(), options_.playback, *player_);
+      if (!bound.ok()) {
+        error = options_.motion + ": " + bound.message();
+        return false;
+      }
+      char line[200];
+      std::snprintf(line, sizeof line,
+                    "motion %s: %d samples, %.2f s%s, %zu joints and %zu ball joints played",
+                    clip_.name.c_str(), clip_.sampleCount(), clip_.duration(),
+                    options_.playback.loop ? " looped" : "", clip_.joints.size(), clip_.balls.size());
+      notes_.push_back(line);
+    }
+    const character::Status played = c->urdf->play(*player_, 0.0);
+    if (!played.ok()) {
+      error = played.message();
+      return false;
+    }
+  }
   // Every character is the same model at the same scale: the first one's hulls serve the crowd.
   const std::vector<character::WorldShape> shapes = c->urdf->skeleton().worldShapes();
   if (!first && characters_.front()->hulls.size() == shapes.size()) {
@@ -339,7 +372,11 @@ Vec3 BulletScene::toWorld(const Vec3& scene) const {
 void BulletScene::poseAt(double t) {
   for (auto& c : characters_) {
     if (c->urdf) {
-      c->urdf->advanceTo(t);
+      if (player_) {
+        (void)c->urdf->play(*player_, t);  // bound to this model at build: cannot fail
+      } else {
+        c->urdf->advanceTo(t);
+      }
       continue;
     }
     c->simple->moveTo(motionAt(motion_, t));  // the colliders, and the bodies' motion states
@@ -347,8 +384,10 @@ void BulletScene::poseAt(double t) {
 }
 
 double BulletScene::stepFrame(double t) {
+  const auto start = std::chrono::steady_clock::now();
   poseAt(t);
   const auto t0 = std::chrono::steady_clock::now();
+  motionUs_ = std::chrono::duration<double, std::micro>(t0 - start).count();
   world_->stepSimulation(btScalar(1.0 / 60.0), 8, btScalar(1.0 / 240.0));
   return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -417,6 +456,7 @@ std::string BulletScene::describe() const {
   std::string links;
   for (const std::string& l : attachLinks_) links += (links.empty() ? "" : ", ") + l;
   return body_ + (links.empty() ? std::string() : ", cape attached to " + links) +
+         (options_.motion.empty() ? std::string() : ", playing " + options_.motion) +
          "; stepSimulation(1/60, 8, 1/240)";
 }
 

@@ -63,6 +63,8 @@ class BulletScene {
   /// Moves every character to its pose at time t (s), then steps the world one 1/60 s frame; returns the
   /// wall time of the stepSimulation call, µs.
   double stepFrame(double t);
+  /// The wall time of the last stepFrame's character motion (poseAt: the gait or the clip), µs.
+  double lastMotionTimeUs() const { return motionUs_; }
 
   /// A character's body colliders at its current pose (true surfaces, ground excluded), for the metrics and
   /// colliders.jsonl, relative to the world point `frame` (a cape's frame; subtracted in double).
@@ -116,6 +118,9 @@ class BulletScene {
   MotionDesc motion_;
   Eigen::Matrix3f toWorld_ = Eigen::Matrix3f::Identity();  ///< Y-up scene frame -> world
   character::UrdfModelPtr model_;
+  character::MotionClip clip_;                       ///< --motion, as loaded
+  std::unique_ptr<character::MotionPlayer> player_;  ///< bound to model_ by the first character
+  double motionUs_ = 0.0;                            ///< stepFrame's poseAt, µs
   CapeSize capeSize_;
   CapeRig rig_;
   std::vector<std::unique_ptr<Character>> characters_;

@@ -183,6 +183,9 @@ void FrameTimings::add(const FrameRow& row) {
   frameTimeUs_.add(row.frameTimeUs);
   capeTimeUs_.add(row.capeTimeUs);
   bulletTimeUs_.add(std::max(0.0, row.frameTimeUs - row.capeTimeUs));
+  motionTimeUs_.add(row.motionTimeUs);
+  const double whole = row.motionTimeUs + row.frameTimeUs;
+  motionShare_.add(whole > 0.0 ? row.motionTimeUs / whole : 0.0);
 }
 
 json summaryFigures(const FrameTimings& timings, const RunSummary& q) {
@@ -214,6 +217,9 @@ json frameShareFigures(const FrameTimings& timings, int capes) {
   j["bullet_time_us_p95"] = timings.bulletTimeUs().percentile(95.0);
   // The median of the frames' cape time / K is the median cape time / K.
   j["cape_time_per_cape_us_median"] = timings.capeTimeUs().percentile(50.0) / std::max(1, capes);
+  j["motion_time_us_median"] = timings.motionTimeUs().percentile(50.0);
+  j["motion_time_us_p95"] = timings.motionTimeUs().percentile(95.0);
+  j["motion_share_median"] = timings.motionShare().percentile(50.0);
   return j;
 }
 

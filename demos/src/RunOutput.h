@@ -27,6 +27,9 @@ struct FrameRow {
   double frameTimeUs = 0.0;  ///< wall time of the whole frame step
   double capeTimeUs = 0.0;   ///< the cape solver's share (the rest is Bullet's own)
   FrameMetrics metrics;
+  /// Wall time of moving the characters to the frame's pose before the step (the gait or a motion clip:
+  /// forward kinematics and the kinematic bodies' transforms and velocities), not in frameTimeUs.
+  double motionTimeUs = 0.0;
 };
 
 /// The cape's settings as written to summary.json and compare.json (units in the key names).
@@ -69,16 +72,20 @@ class FrameTimings {
   const PercentileEstimator& frameTimeUs() const { return frameTimeUs_; }
   const PercentileEstimator& capeTimeUs() const { return capeTimeUs_; }
   const PercentileEstimator& bulletTimeUs() const { return bulletTimeUs_; }
+  const PercentileEstimator& motionTimeUs() const { return motionTimeUs_; }
+  const PercentileEstimator& motionShare() const { return motionShare_; }  ///< per frame, 0..1
 
  private:
-  PercentileEstimator frameTimeUs_, capeTimeUs_, bulletTimeUs_;
+  PercentileEstimator frameTimeUs_, capeTimeUs_, bulletTimeUs_, motionTimeUs_, motionShare_;
 };
 
 /// Summary figures of a run: its timings' median and p95 and the quality summary.
 nlohmann::json summaryFigures(const FrameTimings& timings, const RunSummary& quality);
 
-/// How a cape_walk frame divides: Bullet's own share (bullet_time_us_median, _p95) and the cape time per
-/// cape (cape_time_per_cape_us_median: the median cape time over `capes`).
+/// How a cape_walk frame divides: Bullet's own share (bullet_time_us_median, _p95), the cape time per
+/// cape (cape_time_per_cape_us_median: the median cape time over `capes`), and the characters' motion
+/// before the step (motion_time_us_median, _p95; motion_share_median: the median over frames of motion
+/// time / (motion time + frame time)).
 nlohmann::json frameShareFigures(const FrameTimings& timings, int capes);
 
 /// Which demo's files an output folder holds.

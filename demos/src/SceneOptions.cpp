@@ -58,6 +58,32 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
                  "starts the scene at this world position, m: X,Y,Z (default 0,0,0; where the character "
                  "starts)")
       ->check(strictVector3(kMaxOrigin));
+  app.add_option("--motion", cli.motion,
+                 "a motion clip the character plays instead of the procedural gait: joint-trajectory CSV, "
+                 "DeepMimic (.txt/.json) or BVH (character/README.md, \"Motion clips\")")
+      ->check(CLI::ExistingFile);
+  app.add_option("--motion-format", cli.motionFormat, "auto (from the file) | csv | deepmimic | bvh")
+      ->check(CLI::IsMember({"auto", "csv", "deepmimic", "bvh"}))
+      ->capture_default_str();
+  app.add_option("--motion-scale", cli.motionScale,
+                 "BVH: metres per BVH unit (0.01 for centimetres, 0.0254 for inches; default: guessed from "
+                 "the skeleton's height)")
+      ->transform(strictReal(1e-6, 1e3));
+  app.add_option("--motion-speed", cli.motionSpeed, "playback speed (clip seconds per second)")
+      ->transform(strictReal(1e-3, 1e3))
+      ->capture_default_str();
+  app.add_option("--motion-start", cli.motionStart, "clip time at the first frame, s")
+      ->transform(strictReal(-kMaxSeconds, kMaxSeconds))
+      ->capture_default_str();
+  app.add_flag("--motion-in-place", cli.motionInPlace,
+               "play the clip in place (its root's horizontal motion left out)");
+  app.add_option("--motion-frame", cli.motionFrame,
+                 "CSV: the frame of the root columns: urdf (z up, x forward) | world (the world of --up)")
+      ->check(CLI::IsMember({"urdf", "world"}))
+      ->capture_default_str();
+  app.add_option("--motion-map", cli.motionMap,
+                 "BVH: joints the naming schemes miss, as bvh_joint=role,... (roles: hips, spine, neck, "
+                 "left_hip, left_knee, left_ankle, left_shoulder, left_elbow, right_...)");
 }
 
 bool toRunOptions(const SceneCli& cli, RunOptions& o, std::string& error) {
@@ -86,6 +112,35 @@ bool toRunOptions(const SceneCli& cli, RunOptions& o, std::string& error) {
       error = "--origin: " + why;
       return false;
     }
+  }
+  if (!cli.motion.empty()) {
+    if (cli.simpleBody) {
+      error = "--motion needs a URDF character (the simple body has no joints to play)";
+      return false;
+    }
+    o.motion = cli.motion;
+    (void)character::parseMotionFormat(cli.motionFormat, o.motionLoad.format);
+    o.motionLoad.csv.frame =
+        cli.motionFrame == "world" ? character::MotionFrame::World : character::MotionFrame::Urdf;
+    o.motionLoad.bvh.scale = cli.motionScale;
+    for (std::size_t start = 0; start <= cli.motionMap.size();) {
+      const std::size_t comma = cli.motionMap.find(',', start);
+      const std::string item =
+          cli.motionMap.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      if (!item.empty()) {
+        const std::size_t eq = item.find('=');
+        if (eq == std::string::npos || eq == 0 || eq + 1 == item.size()) {
+          error = "--motion-map: '" + item + "' is not bvh_joint=role";
+          return false;
+        }
+        o.motionLoad.bvh.roles.emplace_back(item.substr(0, eq), item.substr(eq + 1));
+      }
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    o.playback.speed = cli.motionSpeed;
+    o.playback.startTime = cli.motionStart;
+    o.playback.rootMotion = !cli.motionInPlace;
   }
   parseSceneKind(cli.scene, o.scene);
   parsePinLayout(cli.attachment, o.pinLayout);

@@ -38,11 +38,19 @@ struct SceneCli {
   std::string modelUp = "auto";
   double scale = 1.0;
   std::string origin;  ///< X,Y,Z, m; empty: the world's origin
+  std::string motion;  ///< clip file
+  std::string motionFormat = "auto";
+  double motionScale = 0.0;  ///< BVH metres per unit; 0: guessed
+  double motionSpeed = 1.0;
+  double motionStart = 0.0;  ///< s into the clip
+  bool motionInPlace = false;
+  std::string motionFrame = "urdf";  ///< CSV root columns: urdf | world
+  std::string motionMap;             ///< BVH joint=role,...
 };
 
 /// Adds --scene, --size, --attachment, --seconds, --characters, --simple-body, --urdf, --attach,
-/// --package-path, --up, --root-height, --pose, --model-up, --scale and --origin; every number read strictly
-/// (CliNumbers.h) within the ranges above or the option's own.
+/// --package-path, --up, --root-height, --pose, --model-up, --scale, --origin and the --motion options; every
+/// number read strictly (CliNumbers.h) within the ranges above or the option's own.
 void addSceneOptions(CLI::App& app, SceneCli& cli);
 
 /// The run options they ask for (the attachment links split at commas; one character unless the crowd).

@@ -2,6 +2,8 @@
 // in a Bullet world (BulletScene.h), the cape attached through the Bullet adapter.
 #pragma once
 
+#include "cape/character/MotionFormats.h"
+
 #include "cape/character/Skeleton.h"
 #include "cape/character/Urdf.h"
 #include "cape/scenes/Metrics.h"
@@ -37,6 +39,9 @@ struct RunOptions {
   character::UrdfLoadOptions::Up modelUp = character::UrdfLoadOptions::Up::Auto;  ///< the model's own up
   double scale = 1.0;                                                             ///< of the URDF model
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< m: the world position where the character starts
+  std::string motion;  ///< a motion clip played instead of the gait (empty: the procedural gait)
+  character::MotionLoadOptions motionLoad;  ///< its format and the format's options
+  character::PlaybackSettings playback;     ///< speed, start, in place
 };
 
 class SceneRun {
@@ -61,6 +66,8 @@ class SceneRun {
   /// updateAction calls, on however many workers), µs; the rest is Bullet's own.
   virtual double lastFrameTimeUs() const = 0;
   virtual double lastCapeTimeUs() const = 0;
+  /// Wall time of the last frame's character motion (the gait or a clip), before its step, µs.
+  virtual double lastMotionTimeUs() const = 0;
   /// Collision objects in the world (every character's bodies and the ground).
   virtual int worldObjectCount() const = 0;
   /// A description for summary.json (body, URDF, attachment links, stepping).

@@ -206,6 +206,7 @@ int main(int argc, char** argv) {
     row.time = f / 60.0;
     row.frameTimeUs = run->lastFrameTimeUs();
     row.capeTimeUs = run->lastCapeTimeUs();
+    row.motionTimeUs = run->lastMotionTimeUs();
     std::vector<Collider> allColliders;
     for (int k = 0; k < run->characterCount(); ++k) {
       // The metrics in the cape's frame (precise however far away the character is)...
@@ -321,6 +322,8 @@ int main(int argc, char** argv) {
               s["bullet_time_us_median"].get<double>(), s["bullet_time_us_p95"].get<double>());
   std::printf("  %-34s %10.2f us\n", "cape time per cape, median",
               s["cape_time_per_cape_us_median"].get<double>());
+  std::printf("  %-34s %10.2f us (%.1f %% of the frame)\n", "character motion, median",
+              s["motion_time_us_median"].get<double>(), 100.0 * s["motion_share_median"].get<double>());
   std::printf("  %-34s %10.2f %%  (median frame %.2f %%, p95 frame %.2f %%)\n", "strain, max",
               100.0 * q.maxStrain, 100.0 * q.medianFrameMaxStrain, 100.0 * q.p95FrameMaxStrain);
   std::printf("  %-34s %10.3f %%\n", "strain, mean", 100.0 * q.meanStrain);

@@ -35,8 +35,10 @@ struct ShoulderAnchors {
 
 /// Anchors from the character's joint mapping: each side's mapped shoulder joint, walked up the arm chain
 /// (through links with a single movable child joint) to the link the arm hangs from. With no mapped
-/// shoulder on a side, the links named like "shoulder" (left/right by their x) are used instead; with none,
-/// an error. Measured at the character's current pose (call right after Character::create).
+/// shoulder on a side, two spherical joints named like "shoulder" (ball shoulders, as PyBullet's DeepMimic
+/// humanoid's: the two farthest apart sideways) pin it to the link they turn from, at their centres; with
+/// none, the links named like "shoulder" (left/right by their x) are used instead; with none, an error.
+/// Measured at the character's current pose (call right after Character::create).
 ShoulderAnchors findShoulderAnchors(const Character& character);
 
 /// Anchors on links the user named (1 or more: the leftmost and rightmost by x are the shoulders; the
