@@ -229,8 +229,10 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
     // One player serves every character (they share the model); each starts in the clip's first pose.
     if (!player_) {
       player_ = std::make_unique<character::MotionPlayer>();
+      character::PlaybackSettings playback = options_.playback;
+      playback.loop = clip_.loop;  // what the file says (DeepMimic's "Loop"; CSV and BVH clips loop)
       const character::Status bound =
-          character::MotionPlayer::create(clip_, c->urdf->skeleton(), options_.playback, *player_);
+          character::MotionPlayer::create(clip_, c->urdf->skeleton(), playback, *player_);
       if (!bound.ok()) {
         error = options_.motion + ": " + bound.message();
         return false;
@@ -239,7 +241,7 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
       std::snprintf(line, sizeof line,
                     "motion %s: %d samples, %.2f s%s, %zu joints and %zu ball joints played",
                     clip_.name.c_str(), clip_.sampleCount(), clip_.duration(),
-                    options_.playback.loop ? " looped" : "", clip_.joints.size(), clip_.balls.size());
+                    playback.loop ? " looped" : ", its ends held", clip_.joints.size(), clip_.balls.size());
       notes_.push_back(line);
     }
     const character::Status played = c->urdf->play(*player_, 0.0);

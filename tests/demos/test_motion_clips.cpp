@@ -453,6 +453,17 @@ TEST(MotionClips, BvhWalkAndRunRetargetedOntoBothHumanoids) {
 namespace cape::demo_test {
 namespace {
 
+// The example clips in demos/clips/ (the README's) are this test's BVH walk and run, byte for byte.
+TEST(MotionClips, TheShippedExampleClipsAreTheTestsOwn) {
+  for (const Stride* s : {&kWalk, &kRun}) {
+    const fs::path file = fs::path(CAPE_CLIPS_DIR) / (std::string(s->name) + ".bvh");
+    std::ifstream in(file, std::ios::binary);
+    ASSERT_TRUE(in) << file;
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_TRUE(text == bvhText(*s)) << file << " differs from what bvhText writes";
+  }
+}
+
 // cape_compare plays the same clip under both capes: ours and btSoftBody's see one motion.
 TEST(MotionClips, CapeCompareTakesTheSameOptions) {
   const fs::path dir = freshDir();
