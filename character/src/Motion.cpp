@@ -318,4 +318,27 @@ void MotionPlayer::sample(double t, MotionPose& out) const {
   out.root.translation() += shift_;
 }
 
+LoopGap loopGap(const MotionClip& clip) {
+  LoopGap gap;
+  const std::size_t n = clip.times.size();
+  if (n < 2 || clip.values.size() != n * clip.joints.size() ||
+      clip.rotations.size() != n * clip.balls.size() || clip.rootRotations.size() != n)
+    return gap;
+  const auto consider = [&](double value, const std::string& where) {
+    if (value > gap.value) gap = {value, where};
+  };
+  const std::size_t last = n - 1, joints = clip.joints.size(), balls = clip.balls.size();
+  for (std::size_t j = 0; j < joints; ++j)
+    consider(std::abs(clip.values[last * joints + j] - clip.values[j]), clip.joints[j]);
+  for (std::size_t b = 0; b < balls; ++b)
+    consider(clip.rotations[last * balls + b].angularDistance(clip.rotations[b]), clip.balls[b]);
+  if (clip.frame != MotionFrame::World) {  // a World clip's up axis is the character's: not known here
+    const Eigen::Vector3d up =
+        clip.frame == MotionFrame::YUp ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+    const double tilt = (clip.rootRotations[last] * up).dot(clip.rootRotations[0] * up);
+    consider(std::acos(std::clamp(tilt, -1.0, 1.0)), "root");
+  }
+  return gap;
+}
+
 }  // namespace cape::character

@@ -1112,10 +1112,20 @@ Eigen::Vector3d BvhRetarget::urdfRestEnd(const UrdfBone& bone, int role) const {
 void BvhRetarget::alignRest() {
   for (UrdfBone& bone : bones_) {
     const int j = roles_[static_cast<std::size_t>(bone.role)].bvhJoint;
-    const Eigen::Vector3d urdfDir = urdfRestEnd(bone, bone.role) - bone.start;
-    const Eigen::Vector3d bvhDir =
-        toCommon_ * (bvhRestEnd(bone.role) - bvhRest_[static_cast<std::size_t>(j)]);
+    Eigen::Vector3d urdfDir = urdfRestEnd(bone, bone.role) - bone.start;
+    Eigen::Vector3d bvhDir = toCommon_ * (bvhRestEnd(bone.role) - bvhRest_[static_cast<std::size_t>(j)]);
     Eigen::Quaterniond align = Eigen::Quaterniond::Identity();
+    if (bone.role == bvh::kLeftAnkle || bone.role == bvh::kRightAnkle) {
+      // A foot stands flat in both rest poses, whatever its bone's direction says (the BVH's ankle to toe
+      // base, a little down; the URDF's ankle to its foot's shapes, well down): only its heading is aligned.
+      const double urdfLength = urdfDir.norm(), bvhLength = bvhDir.norm();
+      urdfDir.z() = 0.0;
+      bvhDir.z() = 0.0;
+      if (urdfDir.norm() > 1e-3 * urdfLength && bvhDir.norm() > 1e-3 * bvhLength)
+        align = Eigen::Quaterniond::FromTwoVectors(urdfDir, bvhDir);
+      bone.restTarget = (align * bone.rest).normalized();
+      continue;
+    }
     if (urdfDir.norm() > 1e-9 && bvhDir.norm() > 1e-12)
       align = Eigen::Quaterniond::FromTwoVectors(urdfDir, bvhDir);
     else
@@ -1360,6 +1370,25 @@ MotionClipResult parse(const std::string& text, const UrdfModelPtr& model, const
   clip.times.reserve(rows), clip.rootPositions.reserve(rows), clip.rootRotations.reserve(rows);
   clip.values.reserve(rows * clip.joints.size()), clip.rotations.reserve(rows * clip.balls.size());
 
+  // A first frame whose rotation channels are mostly exactly 0, before a frame with fewer than half as many
+  // exact zeros, is the reference pose many exporters write (CMU's conversions: a few limbs set, the rest
+  // 0), not motion (a captured angle is never exactly 0): held until the second frame says which.
+  std::vector<char> rotation(static_cast<std::size_t>(header.channels), 0);
+  std::size_t rotations = 0;
+  for (const BvhJoint& joint : header.joints)
+    for (int c = 0; c < joint.channelCount; ++c)
+      if (joint.channels[static_cast<std::size_t>(c)] < 'x') {
+        rotation[static_cast<std::size_t>(joint.firstChannel + c)] = 1;
+        ++rotations;
+      }
+  const auto zeros = [&](const std::vector<double>& r) {
+    std::size_t n = 0;
+    for (std::size_t c = 0; c < r.size(); ++c) n += rotation[c] && r[c] == 0.0 ? 1 : 0;
+    return n;
+  };
+  std::vector<double> held;
+  std::size_t skipped = 0;
+
   std::vector<std::string_view> tok;
   std::string_view line;
   std::vector<double> row(static_cast<std::size_t>(header.channels));
@@ -1386,14 +1415,30 @@ MotionClipResult parse(const std::string& text, const UrdfModelPtr& model, const
         return result;
       }
     }
-    retarget.frame(row, k, clip);
+    if (k == 0 && options.restFrame == BvhRestFrame::Auto && header.frames >= 3 && rotations > 0 &&
+        2 * zeros(row) > rotations) {
+      held = row;
+      continue;
+    }
+    if (k == 1 && !held.empty()) {
+      const std::size_t first = zeros(held), second = zeros(row);
+      if (2 * second >= first) {
+        retarget.frame(held, 0, clip);  // as still as the next one: the clip starts there
+      } else {
+        skipped = 1;
+        result.warnings.push_back(file + ": frame 0 is a reference pose (" + std::to_string(first) + " of " +
+                                  std::to_string(rotations) + " rotations exactly 0, frame 1 " +
+                                  std::to_string(second) + "): not played (BvhOptions::restFrame keeps it)");
+      }
+    }
+    retarget.frame(row, k - skipped, clip);
   }
   std::size_t extra = 0;
   while (lines.next(tok, line)) ++extra;
   if (extra > 0)
     result.warnings.push_back(file + ": " + std::to_string(extra) + " lines after the last of the " +
                               std::to_string(header.frames) + " frames ignored");
-  retarget.finish(header.frames);
+  retarget.finish(header.frames - skipped);
   result.status = clip.check();
   return result;
 }

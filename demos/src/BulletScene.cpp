@@ -230,7 +230,23 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
     if (!player_) {
       player_ = std::make_unique<character::MotionPlayer>();
       character::PlaybackSettings playback = options_.playback;
-      playback.loop = clip_.loop;  // what the file says (DeepMimic's "Loop"; CSV and BVH clips loop)
+      playback.loop = playback.loop && clip_.loop;  // --motion-once, or the file (DeepMimic's "Loop")
+      const character::LoopGap gap = character::loopGap(clip_);
+      if (playback.loop && gap.value > 0.35) {  // 20 degrees
+        char line[300];
+        std::snprintf(
+            line, sizeof line,
+            "motion %s: its last frame is %.2f %s from its first at '%s', so every loop jumps there "
+            "(a clip that is not a cycle); --motion-once plays it once and holds the end",
+            clip_.name.c_str(), gap.value,
+            model_->findJoint(gap.where) >= 0 &&
+                    model_->joints()[static_cast<std::size_t>(model_->findJoint(gap.where))].type ==
+                        character::JointType::Prismatic
+                ? "m"
+                : "rad",
+            gap.where.c_str());
+        warnings_.push_back(line);
+      }
       const character::Status bound =
           character::MotionPlayer::create(clip_, c->urdf->skeleton(), playback, *player_);
       if (!bound.ok()) {

@@ -77,6 +77,10 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
       ->capture_default_str();
   app.add_flag("--motion-in-place", cli.motionInPlace,
                "play the clip in place (its root's horizontal motion left out)");
+  app.add_flag(
+      "--motion-once", cli.motionOnce,
+      "play the clip once and hold its last pose (default: loop it, the root carried over each loop; "
+      "a DeepMimic file with \"Loop\": \"none\" is held too)");
   app.add_option("--motion-frame", cli.motionFrame,
                  "CSV: the frame of the root columns: urdf (z up, x forward) | world (the world of --up)")
       ->check(CLI::IsMember({"urdf", "world"}))
@@ -141,6 +145,7 @@ bool toRunOptions(const SceneCli& cli, RunOptions& o, std::string& error) {
     o.playback.speed = cli.motionSpeed;
     o.playback.startTime = cli.motionStart;
     o.playback.rootMotion = !cli.motionInPlace;
+    o.playback.loop = !cli.motionOnce;
   }
   parseSceneKind(cli.scene, o.scene);
   parsePinLayout(cli.attachment, o.pinLayout);

@@ -44,6 +44,7 @@ struct SceneCli {
   double motionSpeed = 1.0;
   double motionStart = 0.0;  ///< s into the clip
   bool motionInPlace = false;
+  bool motionOnce = false;
   std::string motionFrame = "urdf";  ///< CSV root columns: urdf | world
   std::string motionMap;             ///< BVH joint=role,...
 };

@@ -80,6 +80,36 @@ TEST(MotionClip, CheckNamesWhatIsWrong) {
   EXPECT_FALSE(MotionClip().check().ok());
 }
 
+// A cycle wraps with no gap but the root's carried-over move and turn; half a cycle wraps with the knees'
+// swing; a ball and the root's tilt count too, in the clip's frame.
+TEST(MotionClip, LoopGapSaysWhereAClipThatIsNotACycleJumps) {
+  EXPECT_LT(loopGap(walkClip(30, 1.0, 1.2, 0.7)).value, 1e-12);  // a turning walk: carried over
+  MotionClip half = walkClip(30);
+  const int keep = 16;  // t = 0 .. 0.5: the knees at 0.6 at both ends, the hip at 0 too: no gap yet
+  half.times.resize(keep), half.rootPositions.resize(keep), half.rootRotations.resize(keep);
+  half.values.resize(static_cast<std::size_t>(keep) * half.joints.size());
+  EXPECT_LT(loopGap(half).value, 1e-9);
+  half.times.pop_back(), half.rootPositions.pop_back(), half.rootRotations.pop_back();
+  for (int j = 0; j < 3; ++j) half.values.pop_back();  // t = 0.467: the knees 0.5 sin(0.93 pi) = 0.10 apart
+  const LoopGap g = loopGap(half);
+  EXPECT_NEAR(g.value, 0.5 * std::sin(2.0 * kPi * 14.0 / 30.0), 1e-12);
+  EXPECT_TRUE(g.where == "left_knee" || g.where == "right_knee") << g.where;
+
+  MotionClip ball = walkClip(4);
+  ball.balls = {"neck"};
+  for (int s = 0; s < 5; ++s)
+    ball.rotations.push_back(Eigen::Quaterniond(Eigen::AngleAxisd(0.2 * s, Eigen::Vector3d::UnitX())));
+  EXPECT_NEAR(loopGap(ball).value, 0.8, 1e-9);
+  EXPECT_EQ(loopGap(ball).where, "neck");
+  MotionClip tilt = walkClip(4);
+  tilt.rootRotations.back() = Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY()));
+  EXPECT_NEAR(loopGap(tilt).value, 0.5, 1e-9);
+  EXPECT_EQ(loopGap(tilt).where, "root");
+  tilt.frame = MotionFrame::YUp;  // about y is a heading there
+  EXPECT_LT(loopGap(tilt).value, 1e-9);
+  EXPECT_EQ(loopGap(MotionClip()).value, 0.0);
+}
+
 TEST(MotionPlayer, KeyframesExactlyAtTheirTimesAndInterpolatedBetween) {
   const UrdfModelPtr m = humanoid();
   const Skeleton s = zUp(m);

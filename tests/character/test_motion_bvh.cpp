@@ -331,9 +331,16 @@ std::vector<Eigen::Vector3d> landmarks(const Skeleton& s) {
   return out;
 }
 
+/// The known frames start at the rest pose, played as motion (BvhRestFrame::Auto would leave it out:
+/// Bvh.AReferenceFrameBeforeTheMotionIsLeftOut), so these retargets keep it.
+BvhOptions keepingRest(BvhOptions options = {}) {
+  options.restFrame = BvhRestFrame::Keep;
+  return options;
+}
+
 MotionClipResult retarget(const std::string& text, const BvhOptions& options = {},
                           const UrdfModelPtr& model = humanoid()) {
-  MotionClipResult r = parseBvh(text, model, options, nullptr, 1.0, "test.bvh");
+  MotionClipResult r = parseBvh(text, model, keepingRest(options), nullptr, 1.0, "test.bvh");
   EXPECT_TRUE(r.ok()) << r.status.message();
   return r;
 }
@@ -457,7 +464,7 @@ TEST(Bvh, AWrongScaleMovesTheRootOnlyWithoutLegScaling) {
 TEST(Bvh, TheRootFollowsTheLegsOfALargerCharacter) {
   const std::vector<Frame> frames = knownFrames();
   const MotionClipResult r = parseBvh(writeBvh(humanoidBones(), frames, {yUpAxes(), 0.01, {}}), humanoid(),
-                                      {}, nullptr, 2.0, "big.bvh");
+                                      keepingRest(), nullptr, 2.0, "big.bvh");
   ASSERT_TRUE(r.ok()) << r.status.message();
   const MotionClipResult one = retarget(writeBvh(humanoidBones(), frames, {yUpAxes(), 0.01, {}}));
   for (std::size_t k = 0; k < frames.size(); ++k)
@@ -926,7 +933,7 @@ TEST(Bvh, FilesAreReadWithTheirSizeChecked) {
     std::ofstream out(path, std::ios::binary);
     out << goodText();
   }
-  const MotionClipResult r = readBvh(path, humanoid());
+  const MotionClipResult r = readBvh(path, humanoid(), keepingRest());
   ASSERT_TRUE(r.ok()) << r.status.message();
   EXPECT_EQ(r.clip.name, "walk.bvh");
   expectSameClip(r.clip, retarget(goodText()).clip);
@@ -1108,6 +1115,83 @@ TEST(Bvh, RetargetsOntoBallJointsOfAYUpModel) {
     const Eigen::Vector3d hips = 0.5 * (linkAt(dm, "left_hip") + linkAt(dm, "right_hip"));
     EXPECT_LT((hips - frames[k].hips * (0.83 / 0.80)).norm(), 1e-9);
   }
+}
+
+// --- (8) quirks of real files ------------------------------------------------------------------------
+
+// Many exporters write the reference pose (every rotation 0) as frame 0 before the motion (CMU's BVH
+// conversions do, with the root already where the motion starts): by default it is left out and said; the
+// clip starts at the next frame, at time 0. A clip that starts at rest and stays there a frame keeps it.
+// Every rotation value of one row of a BVH's motion moved by `delta` degrees (a captured frame: no angle
+// exactly 0); the root's position kept.
+std::string turnedRow(const std::string& text, int row, double delta) {
+  std::istringstream in(text);
+  std::ostringstream out;
+  int motionRow = -1;
+  for (std::string line; std::getline(in, line);) {
+    if (motionRow >= 0 && motionRow++ == row) {
+      std::istringstream values(line);
+      double v;
+      for (int c = 0; values >> v; ++c) out << (c == 0 ? "" : " ") << (c < 3 ? v : v + delta);
+      out << "\n";
+      continue;
+    }
+    if (line.rfind("Frame Time", 0) == 0) motionRow = 0;
+    out << line << "\n";
+  }
+  return out.str();
+}
+
+TEST(Bvh, AReferenceFrameBeforeTheMotionIsLeftOut) {
+  const std::vector<Frame> frames = knownFrames();  // frame 0 is the rest pose
+  const std::string text = turnedRow(writeBvh(humanoidBones(), frames, {yUpAxes(), 0.01, {}}), 1, 0.5);
+  const MotionClipResult all = retarget(text);  // kept
+  const MotionClipResult r = parseBvh(text, humanoid(), {}, nullptr, 1.0, "ref.bvh");
+  ASSERT_TRUE(r.ok()) << r.status.message();
+  ASSERT_EQ(r.clip.sampleCount(), all.clip.sampleCount() - 1);
+  EXPECT_TRUE(saysSomething(r.warnings, "frame 0 is a reference pose"));
+  EXPECT_EQ(r.clip.times.front(), 0.0);
+  for (int k = 0; k < r.clip.sampleCount(); ++k) {
+    const std::size_t n = r.clip.joints.size();
+    for (std::size_t j = 0; j < n; ++j)
+      EXPECT_EQ(r.clip.values[static_cast<std::size_t>(k) * n + j],
+                all.clip.values[static_cast<std::size_t>(k + 1) * n + j]);
+    EXPECT_EQ(r.clip.rootPositions[static_cast<std::size_t>(k)],
+              all.clip.rootPositions[static_cast<std::size_t>(k + 1)]);
+  }
+  // Rest twice: the clip starts at rest (nothing left out).
+  std::vector<Frame> still = frames;
+  still.insert(still.begin() + 1, frames[0]);
+  const MotionClipResult s = parseBvh(writeBvh(humanoidBones(), still, {yUpAxes(), 0.01, {}}), humanoid(), {},
+                                      nullptr, 1.0, "s.bvh");
+  ASSERT_TRUE(s.ok());
+  EXPECT_EQ(s.clip.sampleCount(), static_cast<int>(still.size()));
+  EXPECT_FALSE(saysSomething(s.warnings, "reference pose"));
+  // Two frames: nothing left out either.
+  const std::vector<Frame> two(frames.begin(), frames.begin() + 2);
+  const MotionClipResult t =
+      parseBvh(writeBvh(humanoidBones(), two, {yUpAxes(), 0.01, {}}), humanoid(), {}, nullptr, 1.0, "t.bvh");
+  ASSERT_TRUE(t.ok());
+  EXPECT_EQ(t.clip.sampleCount(), 2);
+}
+
+// A capture's foot bone runs from the ankle to the toe base, a little below the horizontal; the URDF's from
+// the ankle to its foot's shapes, well below it. Both feet stand flat at rest, so at rest the ankle is at 0
+// (not turned by the difference of the two directions, which would hold it at a limit).
+TEST(Bvh, FeetAtRestStayFlatWhateverTheirBonesDirection) {
+  std::vector<Bone> bones = humanoidBones();
+  for (Bone& b : bones)
+    if (b.name == "LeftFoot" || b.name == "RightFoot") b.ends = {Eigen::Vector3d(0.12, 0.0, -0.01)};
+  std::vector<Frame> frames(3);
+  frames[1].angles = {{"left_knee", 0.3}};
+  frames[2].angles = {{"left_ankle", 0.3}, {"right_ankle", -0.4}};
+  const MotionClipResult r = retarget(writeBvh(bones, frames, {yUpAxes(), 0.01, {}}));
+  ASSERT_TRUE(r.ok());
+  EXPECT_NEAR(valueOf(r.clip, "left_ankle", 0), 0.0, 1e-9);
+  EXPECT_NEAR(valueOf(r.clip, "right_ankle", 0), 0.0, 1e-9);
+  EXPECT_NEAR(valueOf(r.clip, "left_ankle", 2), 0.3, 1e-6);
+  EXPECT_NEAR(valueOf(r.clip, "right_ankle", 2), -0.4, 1e-6);
+  EXPECT_FALSE(saysSomething(r.warnings, "held at its limits"));
 }
 
 }  // namespace

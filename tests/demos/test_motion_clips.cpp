@@ -481,6 +481,35 @@ TEST(MotionClips, CapeCompareTakesTheSameOptions) {
   EXPECT_LE(j["solvers"][0]["max_penetration_m"].get<double>(), 0.001);
 }
 
+// A clip that is not a cycle (half a stride) is said to jump every loop; --motion-once plays it once and
+// holds its last pose, which ends the walk where the clip does.
+TEST(MotionClips, AClipThatIsNotACycleIsSaidAndCanBePlayedOnce) {
+  const fs::path dir = freshDir();
+  MotionClip clip = shippedHumanoidClip(kWalk);
+  const std::size_t keep = static_cast<std::size_t>(sampleCount(kWalk) / 4);  // a quarter: 0.55 s
+  clip.times.resize(keep), clip.rootPositions.resize(keep), clip.rootRotations.resize(keep);
+  clip.values.resize(keep * clip.joints.size());
+  const fs::path file = writeText(dir / "quarter.csv", character::writeMotionCsv(clip));
+  const std::string base = std::string(CAPE_WALK) + " --motion " + file.string() +
+                           " --seconds 2 --no-frames --frames-every 60 --out ";
+  const Result looped = run(base + (dir / "looped").string());
+  ASSERT_EQ(looped.exitCode, 0) << looped.output;
+  EXPECT_NE(looped.output.find("every loop jumps there"), std::string::npos) << looped.output;
+  const Result once = run(base + (dir / "once").string() + " --motion-once");
+  ASSERT_EQ(once.exitCode, 0) << once.output;
+  EXPECT_EQ(once.output.find("every loop jumps there"), std::string::npos) << once.output;
+  EXPECT_NE(once.output.find("its ends held"), std::string::npos) << once.output;
+  // Held: the body stands where the clip ends (0.53 s at 1.2 m/s: 0.64 m from where it started).
+  const std::vector<std::string> c = lines(dir / "once" / "colliders.jsonl");
+  ASSERT_EQ(c.size(), 2u);
+  const std::array<double, 2> a = bodyCentre(json::parse(c[0])), b = bodyCentre(json::parse(c[1]));
+  EXPECT_LT(std::hypot(b[0] - a[0], b[1] - a[1]), 1e-6);  // seconds 1 and 2: held still
+  // The clip's longest gap, in the words of the warning: a joint named, in rad.
+  const character::LoopGap gap = character::loopGap(clip);
+  EXPECT_GT(gap.value, 0.35);
+  EXPECT_NE(looped.output.find("at '" + gap.where + "'"), std::string::npos) << looped.output;
+}
+
 TEST(MotionClips, BadClipsAndOptionsFailWithAReason) {
   const fs::path dir = freshDir();
   const fs::path walk = writeText(dir / "walk.csv", character::writeMotionCsv(shippedHumanoidClip(kWalk)));

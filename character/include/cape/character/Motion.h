@@ -133,4 +133,16 @@ Eigen::Isometry3d urdfFrameToWorld(const Eigen::Isometry3d& pose, UpAxis up);
 /// Rotation about z that the root's heading (its x axis projected on the ground) makes with +x, rad.
 double headingAboutZ(const Eigen::Quaterniond& q);
 
+/// How far a clip's pose jumps where a loop wraps from its last sample to its first: the largest change of
+/// a scalar joint (rad or m), of a ball joint's rotation (its angle, rad) and of the root's tilt (the angle
+/// between its up axes, rad, in a Urdf or YUp clip; its heading and position are carried over by the loop),
+/// and where it is (a
+/// joint's name or "root"). A cycle (a walk or a run cut at the same phase) has a small gap; a clip that is
+/// not one jumps every loop. 0 and "" for fewer than two samples.
+struct LoopGap {
+  double value = 0.0;
+  std::string where;
+};
+LoopGap loopGap(const MotionClip& clip);
+
 }  // namespace cape::character

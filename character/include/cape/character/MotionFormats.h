@@ -68,11 +68,18 @@ MotionClipResult parseDeepMimic(const std::string& text, const DeepMimicOptions&
 /// The BVH skeleton's up axis: Y (most mocap), Z, or a guess from the rest pose (the axis along which the
 /// head is farthest from the feet).
 enum class BvhUp : int { Auto, Y, Z };
+/// A first frame with more than half of its rotation channels exactly 0, followed by one with fewer than half
+/// as many: the reference (rest or T-) pose many exporters write before the motion (CMU's BVH conversions:
+/// a few limbs set, everything else 0; a captured angle is never exactly 0). Auto leaves it out (said in the
+/// warnings; the clip starts at the second frame, at time 0); Keep plays it. Clips of fewer than 3 frames
+/// are kept whole.
+enum class BvhRestFrame : int { Auto, Keep };
 struct BvhOptions {
   /// Metres per BVH unit; 0: a guess from the skeleton's height in its rest pose (said in the warnings:
   /// centimetres, inches or metres).
   double scale = 0.0;
   BvhUp up = BvhUp::Auto;
+  BvhRestFrame restFrame = BvhRestFrame::Auto;
   /// (BVH joint name, role) pairs for skeletons the common naming schemes miss. Roles by name: "hips",
   /// "spine", "neck", "left_hip", "left_knee", "left_ankle", "left_shoulder", "left_elbow", and right_...
   std::vector<std::pair<std::string, std::string>> roles;
