@@ -4,7 +4,7 @@
 # corpus, and runs a target for SECONDS, or every target one after another for SECONDS each.
 #   bash scripts/fuzz.sh TARGET|all SECONDS [libFuzzer options...]   e.g. bash scripts/fuzz.sh urdf 3600
 #   bash scripts/fuzz.sh build                                       configure, build, write the seeds
-# Targets: urdf, mesh_hull, urdf_mesh, fabric. Each run reads its seeds and tests/fuzz/regressions/TARGET/
+# Targets: urdf, mesh_hull, urdf_mesh, fabric, motion. Each run reads its seeds and tests/fuzz/regressions/TARGET/
 # and keeps what it learns in BUILD/corpus/run/TARGET/ (a later run goes on from there). Anything found
 # (a crash, an input over 2 s, a leak, a sanitizer report, over 2 GB) stops the run with libFuzzer's non-zero
 # status and is written to BUILD/artifacts/TARGET/. Environment: CAPE_FUZZ_BUILD (the build folder,
@@ -13,7 +13,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${CAPE_FUZZ_BUILD:-$root/build-fuzz}"
-targets=(urdf mesh_hull urdf_mesh fabric)
+targets=(urdf mesh_hull urdf_mesh fabric motion)
 usage() { sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 [ $# -ge 1 ] || usage
 
@@ -43,6 +43,7 @@ for t in "${run[@]}"; do
     urdf) extra=(-max_len=32768 -dict="$root/tests/fuzz/urdf.dict") ;;
     mesh_hull | urdf_mesh) extra=(-max_len=16384 -dict="$root/tests/fuzz/mesh.dict") ;;
     fabric) extra=(-max_len=32768) ;;
+    motion) extra=(-max_len=16384 -dict="$root/tests/fuzz/motion.dict") ;;
   esac
   corpus=("$build/corpus/run/$t" "$build/corpus/seeds/$t")
   [ -d "$root/tests/fuzz/regressions/$t" ] && corpus+=("$root/tests/fuzz/regressions/$t")

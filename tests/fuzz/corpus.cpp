@@ -1,7 +1,8 @@
 // Writes the fuzz targets' inputs that are made rather than kept:
 //   OUT/seeds/<target>/  the seed corpus: the repository's own URDF models (every *.urdf in MODELS_DIR),
 //                        hostile variants of them and small hand-made ones, small meshes (STL binary and
-//                        ASCII, OBJ, COLLADA; good and broken) and small fabrics, each in its target's input
+//                        ASCII, OBJ, COLLADA; good and broken), small fabrics and motion clips (CSV,
+//                        DeepMimic, BVH; good and broken), each in its target's input
 //                        format (the comment at the top of each fuzz_<target>.cpp);
 //   OUT/large/<target>/  regression inputs too large to commit (issue 14: 40,000 and 100,000 nested
 //                        elements, a 30,000-link chain), generated the same every time.
@@ -359,6 +360,133 @@ void fabricSeeds(const fs::path& out) {
   write(out, "raw_floats_far.bin", raw.bytes);
 }
 
+// --- Motion clips ---------------------------------------------------------------------------------------
+
+std::string num(double x) {
+  std::ostringstream s;
+  s.precision(6);
+  s << x;
+  return s.str();
+}
+
+const char* const kHumanoidJoints[] = {
+    "left_hip_pitch",      "right_hip_pitch",      "waist",      "neck",
+    "left_knee",           "right_knee",           "left_ankle", "right_ankle",
+    "left_shoulder_pitch", "right_shoulder_pitch", "left_elbow", "right_elbow"};
+
+// A joint-trajectory CSV of the shipped humanoid's twelve joints: `rows` samples of a step in place.
+std::string humanoidCsv(int rows, const std::string& extraColumn = "") {
+  std::string s = "# a step\ntime, root_x, root_y, root_z, root_qx, root_qy, root_qz, root_qw";
+  for (const char* j : kHumanoidJoints) s += std::string(", ") + j;
+  s += extraColumn.empty() ? "" : ", " + extraColumn;
+  s += "\n";
+  for (int r = 0; r < rows; ++r) {
+    const double t = 0.05 * r, phase = std::sin(6.283185307179586 * r / std::max(rows - 1, 1));
+    const double yaw = 0.05 * phase;
+    s += num(t) + ", " + num(0.3 * t) + ", 0, " + num(0.95 + 0.01 * phase) + ", 0, 0, " +
+         num(std::sin(yaw / 2)) + ", " + num(std::cos(yaw / 2));
+    for (std::size_t j = 0; j < std::size(kHumanoidJoints); ++j)
+      s += ", " + num((j % 2 == 0 ? 0.3 : -0.3) * phase * (j < 4 ? 1.0 : 0.5));
+    if (!extraColumn.empty()) s += ", 0.1";
+    s += r % 2 ? "\r\n" : "\n";
+  }
+  return s;
+}
+
+// A DeepMimic motion file: `frames` frames of 44 numbers (duration, root position, root rotation w x y z,
+// then chest, neck, right_hip, right_knee, right_ankle, right_shoulder, right_elbow, left_...).
+std::string deepMimic(int frames, const std::string& loop = "wrap") {
+  std::string s = "{\n\"Loop\": \"" + loop + "\",\n\"Frames\":\n[\n";
+  for (int f = 0; f < frames; ++f) {
+    const double a = 0.2 * std::sin(6.283185307179586 * f / std::max(frames - 1, 1));
+    const std::string ball = num(std::cos(a / 2)) + "," + num(std::sin(a / 2)) + ",0,0";
+    const std::string row = "[0.0333," + num(0.1 * f) + ",0.85,0," + "1,0,0,0," + ball + "," + ball + "," +
+                            ball + "," + num(-a) + "," + ball + "," + ball + "," + num(a) + "," + ball + "," +
+                            num(-a) + "," + ball + "," + ball + "," + num(a) + "]";
+    s += row + (f + 1 < frames ? ",\n" : "\n");
+  }
+  return s + "]\n}\n";
+}
+
+// A BVH with Mixamo's names, Y up, centimetres: hips, spine, neck and head, two legs and two arms.
+std::string mixamoBvh(int frames, bool mixamoPrefix = false) {
+  const std::string p = mixamoPrefix ? "mixamorig:" : "";
+  std::string s = "HIERARCHY\nROOT " + p +
+                  "Hips\n{\n  OFFSET 0 95 0\n"
+                  "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n";
+  s += "  JOINT " + p + "Spine\n  {\n    OFFSET 0 10 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n";
+  s +=
+      "    JOINT " + p + "Neck\n    {\n      OFFSET 0 45 0\n      CHANNELS 3 Zrotation Xrotation Yrotation\n";
+  s += "      JOINT " + p +
+       "Head\n      {\n        OFFSET 0 10 0\n        CHANNELS 3 Zrotation Xrotation "
+       "Yrotation\n        End Site\n        {\n          OFFSET 0 15 0\n        }\n      }\n    }\n";
+  for (const char* side : {"Left", "Right"}) {
+    const std::string x = std::string(side) == "Left" ? "18" : "-18";
+    s += "    JOINT " + p + side + "Arm\n    {\n      OFFSET " + x +
+         " 40 0\n      CHANNELS 3 Zrotation Xrotation Yrotation\n";
+    s += "      JOINT " + p + side +
+         "ForeArm\n      {\n        OFFSET 0 -28 0\n        CHANNELS 3 Zrotation "
+         "Xrotation Yrotation\n        End Site\n        {\n          OFFSET 0 -25 0\n        }\n      }\n"
+         "    }\n";
+  }
+  s += "  }\n";
+  for (const char* side : {"Left", "Right"}) {
+    const std::string x = std::string(side) == "Left" ? "9" : "-9";
+    s += "  JOINT " + p + side + "UpLeg\n  {\n    OFFSET " + x +
+         " -5 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n";
+    s += "    JOINT " + p + side +
+         "Leg\n    {\n      OFFSET 0 -42 0\n      CHANNELS 3 Zrotation Xrotation "
+         "Yrotation\n";
+    s += "      JOINT " + p + side +
+         "Foot\n      {\n        OFFSET 0 -42 0\n        CHANNELS 3 Zrotation "
+         "Xrotation Yrotation\n        End Site\n        {\n          OFFSET 0 -6 12\n        }\n      }\n"
+         "    }\n  }\n";
+  }
+  s += "}\nMOTION\nFrames: " + std::to_string(frames) + "\nFrame Time: 0.0333333\n";
+  // Channels in the order of the hierarchy: Hips (6), Spine, Neck, Head, LeftArm, LeftForeArm, RightArm,
+  // RightForeArm, LeftUpLeg, LeftLeg, LeftFoot, RightUpLeg, RightLeg, RightFoot (3 each).
+  for (int f = 0; f < frames; ++f) {
+    const double a = 25.0 * std::sin(6.283185307179586 * f / std::max(frames - 1, 1));
+    s += num(0.0) + " " + num(95.0) + " " + num(3.0 * f) + " 0 0 0";
+    for (int j = 0; j < 13; ++j) {
+      const double x = j >= 7 ? (j % 3 == 1 ? -std::abs(a) : (j < 10 ? a : -a)) : 0.2 * a;
+      s += " 0 " + num(x) + " 0";
+    }
+    s += "\n";
+  }
+  return s;
+}
+
+void motionSeeds(const fs::path& out) {
+  // Byte 0 as fuzz_motion.cpp reads it: bits 0-1 the format (0 CSV, 1 DeepMimic, 2 BVH), higher bits the
+  // options.
+  const auto seed = [&](const std::string& name, int selector, const std::string& text) {
+    write(out, name, std::string(1, static_cast<char>(selector)) + text);
+  };
+  seed("humanoid_step.csv", 0, humanoidCsv(9));
+  seed("humanoid_step_world.csv", 0 | 4, humanoidCsv(5));
+  seed("humanoid_step_not_looping.csv", 0 | 0x80 | 0x40, humanoidCsv(4));
+  seed("one_sample.csv", 0, humanoidCsv(1));
+  seed("ball_columns.csv", 0, humanoidCsv(3, "left_shoulder_pitch.qx"));
+  seed("unknown_joint.csv", 0, humanoidCsv(3, "tail"));
+  seed("times_backwards.csv", 0, replaced(humanoidCsv(3), "\n0.05,", "\n-0.05,"));
+  seed("nan_value.csv", 0, replaced(humanoidCsv(3), ", 0.95,", ", nan,"));
+  seed("huge_position.csv", 0, replaced(humanoidCsv(4), ", 0.95,", ", 1e308,"));
+  seed("header_only.csv", 0, "time, root_x, root_y, root_z, root_qx, root_qy, root_qz, root_qw\n");
+  seed("walk.txt", 1, deepMimic(6));
+  seed("walk_no_loop.txt", 1, deepMimic(3, "none"));
+  seed("one_frame.txt", 1, deepMimic(1));
+  seed("short_frame.txt", 1, "{\"Loop\":\"wrap\",\"Frames\":[[0.03,0,0.8,0,1,0,0,0]]}");
+  seed("wrong_types.txt", 1, "{\"Loop\":3,\"Frames\":[[\"a\",null,{},[]]]}");
+  seed("zero_quaternion.txt", 1, replaced(deepMimic(2), ",1,0,0,0,", ",0,0,0,0,"));
+  seed("mixamo_walk.bvh", 2, mixamoBvh(8));
+  seed("mixamo_prefix_walk.bvh", 2, mixamoBvh(4, true));
+  seed("mixamo_cm_y_up.bvh", 2 | (1 << 2) | (1 << 4), mixamoBvh(4));
+  seed("mixamo_metres_z_up_in_place.bvh", 2 | (2 << 2) | (2 << 4) | 0x40 | 0x80, mixamoBvh(3));
+  seed("mixamo_hierarchy_only.bvh", 2, mixamoBvh(2).substr(0, mixamoBvh(2).find("MOTION")));
+  seed("mixamo_frame_count_lies.bvh", 2, replaced(mixamoBvh(3), "Frames: 3", "Frames: 300"));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -374,6 +502,7 @@ int main(int argc, char** argv) {
   urdfSeeds(models, out / "seeds" / "urdf");
   meshSeeds(out / "seeds" / "mesh_hull", out / "seeds" / "urdf_mesh");
   fabricSeeds(out / "seeds" / "fabric");
+  motionSeeds(out / "seeds" / "motion");
   // Issue 14, 1: urdfdom's parser recursed per level and overflowed its stack at about 37,000.
   write(out / "large" / "urdf", "nested_40000.urdf", nested(40000));
   write(out / "large" / "urdf", "nested_100000.urdf", nested(100000));
