@@ -978,7 +978,8 @@ void JointMapping::finish(const UrdfModelPtr& model) {
     const auto role = static_cast<GaitRole>(r);
     if (isShoulderRoll(role)) continue;
     if (e.joint < 0) {
-      warnings_.push_back(std::string(toString(role)) + ": no joint found; it stays at rest");
+      warnings_.push_back(std::string(toString(role)) +
+                          ": no joint found; the gait leaves that limb at rest");
       continue;
     }
     const JointDesc& j = model->joints()[static_cast<std::size_t>(e.joint)];

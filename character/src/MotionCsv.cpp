@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <string_view>
 #include <unordered_map>
@@ -289,6 +290,41 @@ MotionClipResult readMotionCsv(const std::string& path, const CsvMotionOptions& 
   result.status = readTextFile(path, options.limits.maxFileBytes, text);
   if (!result.status.ok()) return result;
   return parseMotionCsv(text, options, path);
+}
+
+Status writeMotionCsv(const MotionClip& clip, std::string& out) {
+  const Status checked = clip.check();
+  if (!checked.ok()) return checked;
+  const auto refuse = [&](const std::string& name, const char* why) {
+    return Status::error(ErrorCode::InvalidArgument, "motion clip '" + clip.name + "': joint '" + name +
+                                                         "' cannot be a CSV column: " + why);
+  };
+  const auto writable = [&](const std::string& name, bool scalar) -> Status {
+    if (name.empty()) return refuse(name, "an empty name");
+    if (name.find_first_of(",\r\n") != std::string::npos)
+      return refuse(name, "a comma or a line break in it");
+    if (name.front() == '#') return refuse(name, "it starts with '#' (a comment)");
+    if (std::isspace(static_cast<unsigned char>(name.front())) ||
+        std::isspace(static_cast<unsigned char>(name.back())))
+      return refuse(name, "spaces at an end (they are trimmed on reading)");
+    for (const char* root : kRootNames)
+      if (name == root) return refuse(name, "the name of a root column");
+    if (scalar && name.size() > 3)
+      for (const char* suffix : kBallSuffix)
+        if (name.compare(name.size() - 3, 3, suffix) == 0)
+          return refuse(name, "read back as a ball's column");
+    return Status::success();
+  };
+  for (const std::string& j : clip.joints) {
+    const Status s = writable(j, true);
+    if (!s.ok()) return s;
+  }
+  for (const std::string& b : clip.balls) {
+    const Status s = writable(b, false);
+    if (!s.ok()) return s;
+  }
+  out = writeMotionCsv(clip);
+  return Status::success();
 }
 
 std::string writeMotionCsv(const MotionClip& clip) {

@@ -68,15 +68,19 @@ MotionFormat detectMotionFormat(const std::string& path) {
   const std::string ext = lower(std::filesystem::path(path).extension().string());
   if (ext == ".csv") return MotionFormat::Csv;
   if (ext == ".bvh") return MotionFormat::Bvh;
-  if (ext == ".json" || ext == ".txt") return MotionFormat::DeepMimic;  // PyBullet ships DeepMimic as .txt
+  if (ext == ".json") return MotionFormat::DeepMimic;
+  // PyBullet ships DeepMimic as .txt, but a .txt may be anything: its first bytes decide, DeepMimic if
+  // they say nothing.
+  const bool text = ext == ".txt";
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return MotionFormat::Auto;
+  if (!std::filesystem::is_regular_file(path, ec)) return text ? MotionFormat::DeepMimic : MotionFormat::Auto;
   std::ifstream in(path, std::ios::binary);
-  if (!in) return MotionFormat::Auto;
+  if (!in) return text ? MotionFormat::DeepMimic : MotionFormat::Auto;
   std::string head(kSniffBytes, '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
-  return formatFromContent(head);
+  const MotionFormat found = formatFromContent(head);
+  return text && found == MotionFormat::Auto ? MotionFormat::DeepMimic : found;
 }
 
 MotionClipResult loadMotion(const std::string& path, const UrdfModelPtr& model,

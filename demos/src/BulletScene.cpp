@@ -250,7 +250,7 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
       const character::Status bound =
           character::MotionPlayer::create(clip_, c->urdf->skeleton(), playback, *player_);
       if (!bound.ok()) {
-        error = options_.motion + ": " + bound.message();
+        error = bound.message();  // names the clip
         return false;
       }
       char line[200];

@@ -117,6 +117,31 @@ TEST(MotionCsv, AWrittenClipReadsBackBitForBit) {
   EXPECT_EQ(writeMotionCsv(again), text);
 }
 
+// The checked writer refuses what would not read back as it was, naming the joint; else it writes the same.
+TEST(MotionCsv, TheCheckedWriterRefusesNamesTheFormatCannotHold) {
+  const MotionClip good = awkwardClip();
+  std::string out = "untouched";
+  ASSERT_TRUE(writeMotionCsv(good, out).ok());
+  EXPECT_EQ(out, writeMotionCsv(good));
+  for (const std::string& bad :
+       {std::string("a,b"), std::string("line\nbreak"), std::string("#hash"), std::string(" padded"),
+        std::string(""), std::string("root_x"), std::string("time"), std::string("knee.qw")}) {
+    MotionClip c = good;
+    c.joints[0] = bad;
+    out = "untouched";
+    const Status s = writeMotionCsv(c, out);
+    EXPECT_EQ(s.code(), ErrorCode::InvalidArgument) << bad;
+    EXPECT_TRUE(has(s.message(), "cannot be a CSV column") || bad.empty()) << s.message();
+    EXPECT_EQ(out, "untouched") << bad;
+  }
+  MotionClip ball = good;
+  ball.balls[0] = "neck,1";
+  EXPECT_FALSE(writeMotionCsv(ball, out).ok());
+  MotionClip broken = good;
+  broken.times[1] = broken.times[0];
+  EXPECT_FALSE(writeMotionCsv(broken, out).ok());
+}
+
 TEST(MotionCsv, AWrittenFileReadsBackBitForBit) {
   TempDir dir;
   const MotionClip clip = awkwardClip();
@@ -607,6 +632,15 @@ TEST(MotionFormat, TheExtensionDecidesFirst) {
   // Over what the file holds.
   EXPECT_EQ(detectMotionFormat(dir.write("mocap.csv", "HIERARCHY\n")), MotionFormat::Csv);
   EXPECT_EQ(detectMotionFormat(dir.path("walk.motion")), MotionFormat::Auto);  // missing, no extension known
+}
+
+// A .txt is PyBullet's DeepMimic by name, but its content decides when it says something.
+TEST(MotionFormat, ATxtFileIsReadByItsFirstBytes) {
+  TempDir dir;
+  EXPECT_EQ(detectMotionFormat(dir.write("a.txt", "{\"Loop\": \"wrap\"}")), MotionFormat::DeepMimic);
+  EXPECT_EQ(detectMotionFormat(dir.write("b.txt", "HIERARCHY\nROOT Hips\n")), MotionFormat::Bvh);
+  EXPECT_EQ(detectMotionFormat(dir.write("c.txt", "time, root_x\n")), MotionFormat::Csv);
+  EXPECT_EQ(detectMotionFormat(dir.write("d.txt", "something else")), MotionFormat::DeepMimic);
 }
 
 TEST(MotionFormat, WithoutAKnownExtensionTheFirstBytesDecide) {

@@ -19,8 +19,9 @@ enum class MotionFormat : int { Auto, Csv, DeepMimic, Bvh };
 const char* toString(MotionFormat format);
 /// "csv", "deepmimic", "bvh" or "auto"; false for anything else.
 bool parseMotionFormat(const std::string& text, MotionFormat& out);
-/// The format of a file from its extension (.csv, .bvh; .json and .txt are DeepMimic), else from its first
-/// bytes ("HIERARCHY" is BVH, a '{' DeepMimic, a header starting with "time" CSV). Auto when none fits.
+/// The format of a file from its extension (.csv, .bvh; .json is DeepMimic), else from its first bytes
+/// ("HIERARCHY" is BVH, a '{' DeepMimic, a header starting with "time" CSV). A .txt (PyBullet's DeepMimic
+/// files) is read by its first bytes too, and is DeepMimic when they fit none. Auto when nothing fits.
 MotionFormat detectMotionFormat(const std::string& path);
 
 /// The most a motion file may hold; over a limit is InvalidArgument naming it.
@@ -46,6 +47,10 @@ MotionClipResult parseMotionCsv(const std::string& text, const CsvMotionOptions&
                                 const std::string& name = "csv");
 /// Writes a clip in that format (the inverse of parseMotionCsv, to 17 significant digits).
 std::string writeMotionCsv(const MotionClip& clip);
+/// The same, checked first: InvalidArgument (nothing written to `out`) for a clip that fails check() or a
+/// joint name the format cannot hold (empty; a ',', '#', a line break, or spaces at either end; a root
+/// column's name; a scalar joint named like a ball column, "NAME.qx"), naming it.
+Status writeMotionCsv(const MotionClip& clip, std::string& out);
 
 // --- DeepMimic motion files ---------------------------------------------------------------------------
 // JSON `{"Loop": "wrap"|"none", "Frames": [[duration, root position (3), root rotation (w x y z),
