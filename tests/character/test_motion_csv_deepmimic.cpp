@@ -596,6 +596,13 @@ TEST(DeepMimic, LimitsRefuseTooManyFramesValuesAndBytes) {
   r = readDeepMimic(path, options);
   ASSERT_TRUE(r.ok()) << r.status.message();
   EXPECT_EQ(r.clip.name, path);
+  // By default 64 MiB (the document is built whole: about four times the text in memory), said before any
+  // of it is parsed.
+  EXPECT_EQ(DeepMimicOptions().limits.maxFileBytes, std::size_t(64) << 20);
+  EXPECT_EQ(DeepMimicOptions().limits.maxSamples, MotionLimits().maxSamples);
+  const std::string big = "{\"Frames\": [" + std::string((std::size_t(64) << 20) - 12, ' ') + "]}";
+  r = parseDeepMimic(big);
+  EXPECT_TRUE(has(r.status.message(), "MotionLimits::maxFileBytes")) << r.status.message();
 }
 
 TEST(DeepMimic, AMissingFileIsFileNotFound) {

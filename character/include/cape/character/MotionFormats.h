@@ -61,7 +61,9 @@ Status writeMotionCsv(const MotionClip& clip, std::string& out);
 // frame. The root is in the Y-up frame of the file (MotionFrame::YUp), in metres of PyBullet's scaled
 // humanoid (it loads the URDF with globalScaling 0.25).
 struct DeepMimicOptions {
-  MotionLimits limits;
+  /// 64 MiB of text at most (PyBullet's clips are about 100 kB): the JSON document is built whole, about 4
+  /// bytes of memory per byte of text at the peak.
+  MotionLimits limits{std::size_t(64) << 20};
 };
 /// The joint names of that order, and whether each is spherical.
 const std::vector<std::pair<std::string, bool>>& deepMimicJoints();
