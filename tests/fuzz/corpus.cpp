@@ -481,6 +481,7 @@ void motionSeeds(const fs::path& out) {
   seed("zero_quaternion.txt", 1, replaced(deepMimic(2), ",1,0,0,0,", ",0,0,0,0,"));
   seed("mixamo_walk.bvh", 2, mixamoBvh(8));
   seed("mixamo_prefix_walk.bvh", 2, mixamoBvh(4, true));
+  seed("mixamo_walk_onto_balls.bvh", 3, mixamoBvh(8));  // retargeted onto the ball-jointed model
   seed("mixamo_cm_y_up.bvh", 2 | (1 << 2) | (1 << 4), mixamoBvh(4));
   seed("mixamo_metres_z_up_in_place.bvh", 2 | (2 << 2) | (2 << 4) | 0x40 | 0x80, mixamoBvh(3));
   seed("mixamo_hierarchy_only.bvh", 2, mixamoBvh(2).substr(0, mixamoBvh(2).find("MOTION")));

@@ -1,6 +1,7 @@
 // Fuzz target: a motion clip file, as a user hands it to the loaders of MotionFormats.h, then the clip played
 // on the shipped humanoid. Input: byte 0 picks the loader and its options, the rest is the file text.
-//   bits 0-1:        0 parseMotionCsv, 1 parseDeepMimic, 2 and 3 parseBvh (onto UrdfModel::humanoid())
+//   bits 0-1:        0 parseMotionCsv, 1 parseDeepMimic, 2 parseBvh onto UrdfModel::humanoid(), 3 onto a
+//                    model of the DeepMimic humanoid's ball joints (Y-up, turned), where DeepMimic clips play
 //   bits 2-3:        CSV: the root frame (Urdf, World, YUp); BVH: the scale (0 a guess, 0.01, 1, 0.0254)
 //   bits 4-5:        BVH: the up axis (Auto, Y, Z; 3 is Auto)
 //   bit 6:           BVH: scaleRootToLegs off; every format: playback in place (rootMotion off)
@@ -40,6 +41,47 @@ const UrdfModelPtr& humanoidModel() {
 
 const Skeleton& humanoidSkeleton() {
   static const Skeleton skeleton(humanoidModel());
+  return skeleton;
+}
+
+// PyBullet's DeepMimic humanoid's joints (the names and kinds a DeepMimic file drives: ball joints, knees and
+// elbows about z), in a small Y-up model loaded turned onto z, so DeepMimic clips play too.
+const UrdfModelPtr& ballModel() {
+  static const UrdfModelPtr model = [] {
+    std::string urdf =
+        "<robot name='dm'><link name='base'/><joint name='root' type='fixed'><parent link='base'/>"
+        "<child link='root'/></joint><link name='root'/>";
+    const auto joint = [&](const std::string& name, const char* type, const char* parent, const char* xyz) {
+      urdf += "<joint name='" + name + "' type='" + type + "'><parent link='" + parent + "'/><child link='" +
+              name + "'/><origin xyz='" + xyz + "'/>" +
+              (std::string(type) == "revolute"
+                   ? "<axis xyz='0 0 1'/><limit lower='-3.14' upper='3.14' effort='1' velocity='1'/>"
+                   : "") +
+              "</joint><link name='" + name + "'><collision><geometry><sphere radius='0.05'/></geometry>" +
+              "</collision></link>";
+    };
+    joint("chest", "spherical", "root", "0 0.24 0");
+    joint("neck", "spherical", "chest", "0 0.22 0");
+    for (const std::string side : {"right", "left"}) {
+      const char* z = side == "right" ? "0 0 0.08" : "0 0 -0.08";
+      joint(side + "_hip", "spherical", "root", z);
+      joint(side + "_knee", "revolute", (side + "_hip").c_str(), "0 -0.42 0");
+      joint(side + "_ankle", "spherical", (side + "_knee").c_str(), "0 -0.41 0");
+      joint(side + "_shoulder", "spherical", "chest", z);
+      joint(side + "_elbow", "revolute", (side + "_shoulder").c_str(), "0 -0.27 0");
+    }
+    urdf += "</robot>";
+    UrdfLoadOptions options;
+    options.modelUp = UrdfLoadOptions::Up::Y;
+    const UrdfLoadResult loaded = UrdfModel::fromString(urdf, options);
+    if (!loaded.ok()) capefuzz::broken("ballModel", "the ball-jointed model: " + loaded.status.message());
+    return loaded.model;
+  }();
+  return model;
+}
+
+const Skeleton& ballSkeleton() {
+  static const Skeleton skeleton(ballModel());
   return skeleton;
 }
 
@@ -113,12 +155,12 @@ void checkPose(const MotionPose& pose, const MotionPlayer& player, double t) {
   CAPE_FUZZ_CHECK(std::isfinite(c) && c >= 0.0 && c <= player.duration(), at + ": clip time out of range");
 }
 
-void play(const MotionClip& clip, bool loop, bool rootMotion) {
+void play(const MotionClip& clip, const Skeleton& skeleton, bool loop, bool rootMotion) {
   PlaybackSettings settings;
   settings.loop = loop;
   settings.rootMotion = rootMotion;
   MotionPlayer player;
-  const Status bound = MotionPlayer::create(clip, humanoidSkeleton(), settings, player);
+  const Status bound = MotionPlayer::create(clip, skeleton, settings, player);
   if (!bound.ok()) {
     CAPE_FUZZ_CHECK(!bound.message().empty(), "MotionPlayer::create: an error without a message");
     return;
@@ -162,7 +204,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     options.scaleRootToLegs = rootMotion;
     options.loop = loop;
     options.limits = smallLimits();
-    loaded = parseBvh(text, humanoidModel(), options, nullptr, 1.0, "fuzz.bvh");
+    loaded = parseBvh(text, (selector & 3) == 3 ? ballModel() : humanoidModel(), options, nullptr, 1.0,
+                      "fuzz.bvh");
   }
   if (!loaded.ok()) {
     CAPE_FUZZ_CHECK(!loaded.status.message().empty(), "a loader error without a message");
@@ -171,6 +214,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const Status checked = loaded.clip.check();
   CAPE_FUZZ_CHECK(checked.ok(), "a loaded clip fails check(): " + checked.message());
   if (format == 0) checkCsvRoundTrip(loaded.clip, csv);
-  play(loaded.clip, loop, rootMotion);
+  // DeepMimic clips and BVH retargeted onto it (format 3) play on the ball-jointed model, the rest on the
+  // humanoid; anything also on the other (its joints are unknown there: a clean error).
+  const bool balls = format == 1 || (selector & 3) == 3;
+  play(loaded.clip, balls ? ballSkeleton() : humanoidSkeleton(), loop, rootMotion);
+  play(loaded.clip, balls ? humanoidSkeleton() : ballSkeleton(), loop, rootMotion);
   return 0;
 }
