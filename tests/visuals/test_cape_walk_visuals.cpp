@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -61,6 +62,46 @@ TEST(CapeWalkVisuals, GltfAndRenderOfAShortWalk) {
   EXPECT_EQ(w, 200u);
   EXPECT_EQ(h, 120u);
   EXPECT_FALSE(fs::exists(dir / "frames" / "00016.png"));
+  fs::remove_all(dir);
+}
+
+// A motion clip's run is exported and rendered as the gait's is: the body's glTF nodes follow the clip (the
+// BVH walk goes 1.2 m/s: the torso 0.58 m between the first and the last of 30 frames).
+TEST(CapeWalkVisuals, AMotionClipIsExportedAndRenderedLikeTheGait) {
+  const fs::path dir = freshDir();
+  const Result r = runWalk("--motion " + (fs::path(CAPE_CLIPS_DIR) / "walk.bvh").string() +
+                           " --seconds 0.5 --no-frames --out " + (dir / "run").string() + " --gltf " +
+                           (dir / "clip.glb").string() + " --render " + (dir / "frames").string() +
+                           " --render-size 96x64");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("30 frames rendered at 96x64"), std::string::npos) << r.output;
+  unsigned w = 0, h = 0;
+  ASSERT_TRUE(pngSize(dir / "frames" / "00030.png", w, h));
+  EXPECT_EQ(w, 96u);
+
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model m;
+  std::string err, warn;
+  ASSERT_TRUE(loader.LoadBinaryFromFile(&m, &err, &warn, (dir / "clip.glb").string())) << err;
+  ASSERT_EQ(m.animations.size(), 1u);
+  double farthest = 0.0;
+  std::string which;
+  for (const tinygltf::AnimationChannel& c : m.animations[0].channels) {
+    if (c.target_path != "translation" ||
+        m.nodes.at(static_cast<std::size_t>(c.target_node)).name.rfind("torso", 0) != 0)
+      continue;
+    const tinygltf::Accessor& a = m.accessors.at(
+        static_cast<std::size_t>(m.animations[0].samplers.at(static_cast<std::size_t>(c.sampler)).output));
+    ASSERT_EQ(a.componentType, TINYGLTF_COMPONENT_TYPE_FLOAT);
+    ASSERT_EQ(a.count, 30u);
+    const tinygltf::BufferView& v = m.bufferViews.at(static_cast<std::size_t>(a.bufferView));
+    const auto* p = reinterpret_cast<const float*>(
+        m.buffers.at(static_cast<std::size_t>(v.buffer)).data.data() + v.byteOffset + a.byteOffset);
+    const float* q = p + 3 * (a.count - 1);
+    const double moved = std::hypot(q[0] - p[0], q[2] - p[2]);  // horizontally (Y up)
+    if (moved > farthest) farthest = moved, which = m.nodes.at(static_cast<std::size_t>(c.target_node)).name;
+  }
+  EXPECT_NEAR(farthest, 1.2 * 29.0 / 60.0, 0.15) << which;
   fs::remove_all(dir);
 }
 
