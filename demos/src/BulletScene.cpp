@@ -71,6 +71,9 @@ struct BulletScene::Character {
   std::vector<std::pair<float, btRigidBody*>> anchors;  ///< attachment bodies by their x at rest
   Pose placement;
   std::vector<PinSpec> pins;
+  /// A motion clip's first pose from the standing pose the cape was fitted to (the upper torso's rigid move,
+  /// relative to the scene's origin): placeCape carries the cape with it. The identity for the gait.
+  Eigen::Isometry3d carry = Eigen::Isometry3d::Identity();
 };
 
 std::unique_ptr<BulletScene> BulletScene::create(const RunOptions& options, std::string& error,
@@ -260,11 +263,6 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
                     playback.loop ? " looped" : ", its ends held", clip_.joints.size(), clip_.balls.size());
       notes_.push_back(line);
     }
-    const character::Status played = c->urdf->play(*player_, 0.0);
-    if (!played.ok()) {
-      error = played.message();
-      return false;
-    }
   }
   // Every character is the same model at the same scale: the first one's hulls serve the crowd.
   const std::vector<character::WorldShape> shapes = c->urdf->skeleton().worldShapes();
@@ -347,6 +345,30 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
     notes_.push_back(line);
     for (int link : links) attachLinks_.push_back(model_->links()[static_cast<std::size_t>(link)].name);
   }
+  if (player_) {
+    // The cape was fitted to the standing character (the shoulders, the back, the pin line: as for the gait,
+    // whatever pose the clip starts in). Now the clip's first pose, and the cape carried there with the
+    // upper torso (placeCape), relative to the scene's origin as every placement is.
+    btRigidBody* torso = c->urdf->bodies().bodyForLink(c->torsoLink);
+    const auto relative = [&](const btTransform& t) {
+      Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+      const btMatrix3x3& r = t.getBasis();
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) pose.linear()(i, j) = double(r[i][j]);
+      pose.translation() =
+          Eigen::Vector3d(double(t.getOrigin().x()), double(t.getOrigin().y()), double(t.getOrigin().z())) -
+          options_.origin;
+      return pose;
+    };
+    const Eigen::Isometry3d standing =
+        torso ? relative(torso->getWorldTransform()) : Eigen::Isometry3d::Identity();
+    const character::Status played = c->urdf->play(*player_, 0.0);
+    if (!played.ok()) {
+      error = played.message();
+      return false;
+    }
+    if (torso) c->carry = relative(torso->getWorldTransform()) * standing.inverse();
+  }
   characters_.push_back(std::move(c));
   return true;
 }
@@ -361,6 +383,13 @@ void BulletScene::placeCape(Character& c) {
   c.placement.position = toWorld(start.position + c.shift);
   c.placement.rotation = Quat(toWorld_) * start.rotation;
   if (options_.up == character::UpAxis::Y) c.placement.rotation = start.rotation;  // the same bits as ever
+  const bool carried = c.carry.matrix() != Eigen::Matrix4d::Identity();
+  if (carried) {
+    c.placement.position = (c.carry * c.placement.position.cast<double>()).cast<float>();
+    c.placement.rotation = (Eigen::Quaterniond(c.carry.linear()) * c.placement.rotation.cast<double>())
+                               .normalized()
+                               .cast<float>();
+  }
   for (std::size_t p = 0; p < rig_.pinnedParticles.size(); ++p) {
     const Vec3 point = rig_.pinLocalPoints[p] + c.shift;
     const auto nearest =
@@ -378,7 +407,8 @@ void BulletScene::placeCape(Character& c) {
           options_.origin;
       relative.setOrigin(btVector3(btScalar(p0.x()), btScalar(p0.y()), btScalar(p0.z())));
     }
-    c.pins.push_back({rig_.pinnedParticles[p], body, relative.inverse() * toBt(toWorld(point))});
+    const Vec3 at = carried ? (c.carry * toWorld(point).cast<double>()).cast<float>() : toWorld(point);
+    c.pins.push_back({rig_.pinnedParticles[p], body, relative.inverse() * toBt(at)});
   }
 }
 
