@@ -349,25 +349,19 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
     // The cape was fitted to the standing character (the shoulders, the back, the pin line: as for the gait,
     // whatever pose the clip starts in). Now the clip's first pose, and the cape carried there with the
     // upper torso (placeCape), relative to the scene's origin as every placement is.
-    btRigidBody* torso = c->urdf->bodies().bodyForLink(c->torsoLink);
-    const auto relative = [&](const btTransform& t) {
-      Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-      const btMatrix3x3& r = t.getBasis();
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) pose.linear()(i, j) = double(r[i][j]);
-      pose.translation() =
-          Eigen::Vector3d(double(t.getOrigin().x()), double(t.getOrigin().y()), double(t.getOrigin().z())) -
-          options_.origin;
+    // The skeleton's link poses, in double: the bodies' float transforms are a millimetre apart 10 km out.
+    const auto relative = [&]() {
+      Eigen::Isometry3d pose = c->urdf->skeleton().linkPose(c->torsoLink);
+      pose.translation() -= options_.origin;
       return pose;
     };
-    const Eigen::Isometry3d standing =
-        torso ? relative(torso->getWorldTransform()) : Eigen::Isometry3d::Identity();
+    const Eigen::Isometry3d standing = relative();
     const character::Status played = c->urdf->play(*player_, 0.0);
     if (!played.ok()) {
       error = played.message();
       return false;
     }
-    if (torso) c->carry = relative(torso->getWorldTransform()) * standing.inverse();
+    c->carry = relative() * standing.inverse();
   }
   characters_.push_back(std::move(c));
   return true;
