@@ -1,11 +1,22 @@
 // Builds a canonical cape from the installed headers and library, hangs it from two pins for one second and
-// checks that it fell and stayed finite. Exit status 0 on success.
+// checks that it fell and stayed finite; and checks that the package, the headers and the library report one
+// version. Exit status 0 on success. (Built by CMake against the CMake package, and by CI with nothing but
+// `pkg-config --cflags --libs capecloth-core`, where CAPE_PACKAGE_VERSION is pkg-config's --modversion.)
 #include <cape/core/Cape.h>
+#include <cape/core/Version.h>
 #include <cape/scenes/Metrics.h>
 
 #include <cstdio>
+#include <cstring>
 
 int main() {
+  std::printf("consumer: CapeCloth headers %s, library %s, package %s\n", CAPE_VERSION_STRING, cape::version(),
+              CAPE_PACKAGE_VERSION);
+  if (std::strcmp(cape::version(), CAPE_VERSION_STRING) != 0 ||
+      std::strcmp(cape::version(), CAPE_PACKAGE_VERSION) != 0) {
+    std::fprintf(stderr, "consumer: the versions differ\n");
+    return 1;
+  }
   cape::GridDesc grid;
   grid.tetherAnchors = {0, 19};
   const cape::FabricResult fabric = cape::Fabric::grid(grid);
