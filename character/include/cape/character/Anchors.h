@@ -5,6 +5,7 @@
 #pragma once
 
 #include "cape/character/Character.h"
+#include "cape/character/Export.h"
 #include "cape/character/Grounding.h"
 #include "cape/character/Status.h"
 
@@ -39,11 +40,12 @@ struct ShoulderAnchors {
 /// humanoid's: the two farthest apart sideways) pin it to the link they turn from, at their centres; with
 /// none, the links named like "shoulder" (left/right by their x) are used instead; with none, an error.
 /// Measured at the character's current pose (call right after Character::create).
-ShoulderAnchors findShoulderAnchors(const Character& character);
+CAPE_CHARACTER_API ShoulderAnchors findShoulderAnchors(const Character& character);
 
 /// Anchors on links the user named (1 or more: the leftmost and rightmost by x are the shoulders; the
 /// shoulder points are the links' origins). UnknownLink naming the model's links when one does not exist;
 /// InvalidArgument when a link has no body and no ancestor with one.
-ShoulderAnchors shoulderAnchorsOnLinks(const Character& character, const std::vector<std::string>& links);
+CAPE_CHARACTER_API ShoulderAnchors shoulderAnchorsOnLinks(const Character& character,
+                                                          const std::vector<std::string>& links);
 
 }  // namespace cape::character

@@ -21,6 +21,7 @@
 #pragma once
 
 #include "cape/character/CharacterBodies.h"
+#include "cape/character/Export.h"
 #include "cape/character/Gait.h"
 #include "cape/character/JointMapping.h"
 #include "cape/character/Motion.h"
@@ -61,7 +62,7 @@ struct CharacterSettings {
 /// around names and values allowed; an empty text is an empty pose). InvalidArgument, saying which entry and
 /// why, for an entry without '=', an empty name, a value that is not a number or not finite, or a name given
 /// twice; `out` is then left empty.
-Status parsePose(const std::string& text, JointPose& out);
+CAPE_CHARACTER_API Status parsePose(const std::string& text, JointPose& out);
 
 class Character;
 struct CharacterResult {
@@ -70,7 +71,7 @@ struct CharacterResult {
   bool ok() const { return status.ok() && character != nullptr; }
 };
 
-class Character {
+class CAPE_CHARACTER_API Character {
  public:
   /// Builds the skeleton (joints mapped with JointMapping::automatic, unless `mapping` is given), applies the
   /// settings' pose, places the root on the ground (see CharacterSettings::rootHeight), poses it at t = 0 and

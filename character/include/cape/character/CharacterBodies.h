@@ -24,6 +24,7 @@
 // Skeleton it reads.
 #pragma once
 
+#include "cape/character/Export.h"
 #include "cape/character/Skeleton.h"
 #include "cape/character/Status.h"
 
@@ -62,7 +63,7 @@ struct LinkBodyTag {
   std::string linkName;
 };
 
-class CharacterBodies {
+class CAPE_CHARACTER_API CharacterBodies {
  public:
   /// Builds the bodies at the skeleton's current pose, at rest, and adds them to `world`.
   CharacterBodies(btDynamicsWorld& world, const Skeleton& skeleton, const BodySettings& settings = {});
@@ -116,6 +117,6 @@ class CharacterBodies {
 };
 
 /// A link pose as a Bullet transform (btScalar precision).
-btTransform toBullet(const Eigen::Isometry3d& pose);
+CAPE_CHARACTER_API btTransform toBullet(const Eigen::Isometry3d& pose);
 
 }  // namespace cape::character

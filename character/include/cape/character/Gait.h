@@ -25,6 +25,7 @@
 // but the shoulder roll's O: the standing pose (standingAngles), the rest pose with the arms down.
 #pragma once
 
+#include "cape/character/Export.h"
 #include "cape/character/JointMapping.h"
 #include "cape/character/Skeleton.h"
 
@@ -34,7 +35,7 @@
 
 namespace cape::character {
 
-struct GaitParams {
+struct CAPE_CHARACTER_API GaitParams {
   double speed = 0.0;            ///< m/s along the heading
   double turnRate = 0.0;         ///< rad/s about world +Y (positive turns to the character's left)
   double stepFrequency = 0.0;    ///< Hz: full leg cycles per second (one left and one right step),
@@ -67,7 +68,7 @@ struct RootPose {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
 };
 
-class Gait {
+class CAPE_CHARACTER_API Gait {
  public:
   /// A gait of its own: root motion from speed and turn rate (exactly motionAt's straight line when the turn
   /// rate is 0).

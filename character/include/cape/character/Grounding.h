@@ -5,6 +5,7 @@
 // Every height here is world y (Y up, docs/SCENES.md), in metres.
 #pragma once
 
+#include "cape/character/Export.h"
 #include "cape/character/Skeleton.h"
 #include "cape/character/Urdf.h"
 
@@ -23,20 +24,20 @@ namespace cape::character {
 ///             length h
 ///   capsule   the lower of its two sphere centres (centre +- h a) - r
 ///   hull      its lowest vertex - radius (its rounding); +infinity for a hull without vertices
-double lowestPointY(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
+CAPE_CHARACTER_API double lowestPointY(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
 
 /// The exact axis-aligned bounds of one collision shape placed at `pose` (m, in whatever frame pose is in):
 /// lowestPointY is its min().y().
-Eigen::AlignedBox3d shapeBounds(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
+CAPE_CHARACTER_API Eigen::AlignedBox3d shapeBounds(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
 
 /// The bounds of every collision shape of the skeleton at its current pose, in the frame `turn` takes the
 /// world into (the identity: the world; Skeleton::urdfToWorld().transpose(): the URDF's axes). Empty when
 /// it has no shapes.
-Eigen::AlignedBox3d skeletonBounds(const Skeleton& skeleton, const Eigen::Matrix3d& turn);
+CAPE_CHARACTER_API Eigen::AlignedBox3d skeletonBounds(const Skeleton& skeleton, const Eigen::Matrix3d& turn);
 
 /// The lowest world y over every collision shape of the skeleton at its current pose; none when it has no
 /// shapes (or only empty hulls).
-std::optional<double> lowestCollisionPoint(const Skeleton& skeleton);
+CAPE_CHARACTER_API std::optional<double> lowestCollisionPoint(const Skeleton& skeleton);
 
 /// Where a character's root goes.
 struct GroundPlacement {
@@ -54,6 +55,7 @@ struct GroundPlacement {
 /// root stays at 0 (or `rootHeight`) with a warning. A floating base is said: the root origin more than
 /// 0.3 m above the lowest point (a root at the pelvis), a floating joint out of the root link, or a root that
 /// is a dummy link named "world" without shapes.
-GroundPlacement placeOnGround(const Skeleton& standing, const std::optional<double>& rootHeight = {});
+CAPE_CHARACTER_API GroundPlacement placeOnGround(const Skeleton& standing,
+                                                 const std::optional<double>& rootHeight = {});
 
 }  // namespace cape::character

@@ -29,6 +29,7 @@
 // structure fills what they left empty, saying each such choice in warnings().
 #pragma once
 
+#include "cape/character/Export.h"
 #include "cape/character/Urdf.h"
 
 #include <array>
@@ -52,9 +53,9 @@ enum class GaitRole : int {
   RightShoulderRoll,
 };
 constexpr int kGaitRoleCount = 12;
-const char* toString(GaitRole role);
+CAPE_CHARACTER_API const char* toString(GaitRole role);
 
-class JointMapping {
+class CAPE_CHARACTER_API JointMapping {
  public:
   struct Entry {
     int joint = -1;     ///< index into UrdfModel::joints(); -1 = unmapped (that joint stays at rest)

@@ -18,6 +18,7 @@
 // Y-up humanoid), turned onto z as the URDF loader turns a Y-up model. The player works in the URDF frame.
 #pragma once
 
+#include "cape/character/Export.h"
 #include "cape/character/Skeleton.h"
 #include "cape/character/Status.h"
 
@@ -34,10 +35,10 @@ enum class MotionFrame : int {
   YUp,    ///< x forward, y up, z right (DeepMimic); for a model turned onto z (UrdfModel::turnedOntoZ) the
           ///< root rotation is taken as the file's, before the turn
 };
-const char* toString(MotionFrame frame);
+CAPE_CHARACTER_API const char* toString(MotionFrame frame);
 
 /// Samples of a motion: times, the root link's pose and named joints' positions at each.
-struct MotionClip {
+struct CAPE_CHARACTER_API MotionClip {
   std::string name;                               ///< where it came from (file name), for messages
   MotionFrame frame = MotionFrame::Urdf;          ///< the frame of rootPositions and rootRotations
   std::vector<double> times;                      ///< s, strictly increasing, times[0] >= 0
@@ -88,7 +89,7 @@ struct MotionPose {
   std::vector<Eigen::Quaterniond> rotations;
 };
 
-class MotionPlayer {
+class CAPE_CHARACTER_API MotionPlayer {
  public:
   /// Binds `clip` to `skeleton`'s model: every scalar joint must be a movable joint of it and every ball a
   /// spherical one (UnknownJoint / NotMovable otherwise, the message listing the model's joints of that
@@ -125,13 +126,13 @@ class MotionPlayer {
 
 /// A root link pose given in `frame` as a pose in the URDF frame, for `skeleton` (its up axis for World, its
 /// model's turnedOntoZ for YUp).
-Eigen::Isometry3d rootPoseToUrdfFrame(const Eigen::Isometry3d& pose, MotionFrame frame,
-                                      const Skeleton& skeleton);
+CAPE_CHARACTER_API Eigen::Isometry3d rootPoseToUrdfFrame(const Eigen::Isometry3d& pose, MotionFrame frame,
+                                                         const Skeleton& skeleton);
 /// A pose in the URDF frame as a pose in a world with that up axis (the identity for Z).
-Eigen::Isometry3d urdfFrameToWorld(const Eigen::Isometry3d& pose, UpAxis up);
+CAPE_CHARACTER_API Eigen::Isometry3d urdfFrameToWorld(const Eigen::Isometry3d& pose, UpAxis up);
 
 /// Rotation about z that the root's heading (its x axis projected on the ground) makes with +x, rad.
-double headingAboutZ(const Eigen::Quaterniond& q);
+CAPE_CHARACTER_API double headingAboutZ(const Eigen::Quaterniond& q);
 
 /// How far a clip's pose jumps where a loop wraps from its last sample to its first: the largest change of
 /// a scalar joint (rad or m), of a ball joint's rotation (its angle, rad) and of the root's tilt (the angle
@@ -143,6 +144,6 @@ struct LoopGap {
   double value = 0.0;
   std::string where;
 };
-LoopGap loopGap(const MotionClip& clip);
+CAPE_CHARACTER_API LoopGap loopGap(const MotionClip& clip);
 
 }  // namespace cape::character

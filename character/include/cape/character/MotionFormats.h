@@ -4,6 +4,7 @@
 // formats and the retargeting rules are documented in character/README.md ("Motion clips").
 #pragma once
 
+#include "cape/character/Export.h"
 #include "cape/character/JointMapping.h"
 #include "cape/character/Motion.h"
 #include "cape/character/Urdf.h"
@@ -16,13 +17,13 @@
 namespace cape::character {
 
 enum class MotionFormat : int { Auto, Csv, DeepMimic, Bvh };
-const char* toString(MotionFormat format);
+CAPE_CHARACTER_API const char* toString(MotionFormat format);
 /// "csv", "deepmimic", "bvh" or "auto"; false for anything else.
-bool parseMotionFormat(const std::string& text, MotionFormat& out);
+CAPE_CHARACTER_API bool parseMotionFormat(const std::string& text, MotionFormat& out);
 /// The format of a file from its extension (.csv, .bvh; .json is DeepMimic), else from its first bytes
 /// ("HIERARCHY" is BVH, a '{' DeepMimic, a header starting with "time" CSV). A .txt (PyBullet's DeepMimic
 /// files) is read by its first bytes too, and is DeepMimic when they fit none. Auto when nothing fits.
-MotionFormat detectMotionFormat(const std::string& path);
+CAPE_CHARACTER_API MotionFormat detectMotionFormat(const std::string& path);
 
 /// The most a motion file may hold; over a limit is InvalidArgument naming it.
 struct MotionLimits {
@@ -42,15 +43,17 @@ struct CsvMotionOptions {
   bool loop = true;
   MotionLimits limits;
 };
-MotionClipResult readMotionCsv(const std::string& path, const CsvMotionOptions& options = {});
-MotionClipResult parseMotionCsv(const std::string& text, const CsvMotionOptions& options = {},
-                                const std::string& name = "csv");
+CAPE_CHARACTER_API MotionClipResult readMotionCsv(const std::string& path,
+                                                  const CsvMotionOptions& options = {});
+CAPE_CHARACTER_API MotionClipResult parseMotionCsv(const std::string& text,
+                                                   const CsvMotionOptions& options = {},
+                                                   const std::string& name = "csv");
 /// Writes a clip in that format (the inverse of parseMotionCsv, to 17 significant digits).
-std::string writeMotionCsv(const MotionClip& clip);
+CAPE_CHARACTER_API std::string writeMotionCsv(const MotionClip& clip);
 /// The same, checked first: InvalidArgument (nothing written to `out`) for a clip that fails check() or a
 /// joint name the format cannot hold (empty; a ',', '#', a line break, or spaces at either end; a root
 /// column's name; a scalar joint named like a ball column, "NAME.qx"), naming it.
-Status writeMotionCsv(const MotionClip& clip, std::string& out);
+CAPE_CHARACTER_API Status writeMotionCsv(const MotionClip& clip, std::string& out);
 
 // --- DeepMimic motion files ---------------------------------------------------------------------------
 // JSON `{"Loop": "wrap"|"none", "Frames": [[duration, root position (3), root rotation (w x y z),
@@ -66,10 +69,12 @@ struct DeepMimicOptions {
   MotionLimits limits{std::size_t(64) << 20};
 };
 /// The joint names of that order, and whether each is spherical.
-const std::vector<std::pair<std::string, bool>>& deepMimicJoints();
-MotionClipResult readDeepMimic(const std::string& path, const DeepMimicOptions& options = {});
-MotionClipResult parseDeepMimic(const std::string& text, const DeepMimicOptions& options = {},
-                                const std::string& name = "deepmimic");
+CAPE_CHARACTER_API const std::vector<std::pair<std::string, bool>>& deepMimicJoints();
+CAPE_CHARACTER_API MotionClipResult readDeepMimic(const std::string& path,
+                                                  const DeepMimicOptions& options = {});
+CAPE_CHARACTER_API MotionClipResult parseDeepMimic(const std::string& text,
+                                                   const DeepMimicOptions& options = {},
+                                                   const std::string& name = "deepmimic");
 
 // --- BVH motion capture, retargeted -------------------------------------------------------------------
 /// The BVH skeleton's up axis: Y (most mocap), Z, or a guess from the rest pose (the axis along which the
@@ -97,11 +102,14 @@ struct BvhOptions {
 };
 /// Reads a BVH and retargets it onto `model` (its joints mapped by `mapping`, or JointMapping::automatic):
 /// the result is a clip of the model's own joints in the URDF frame, for a character of `characterScale`.
-MotionClipResult readBvh(const std::string& path, const UrdfModelPtr& model, const BvhOptions& options = {},
-                         const JointMapping* mapping = nullptr, double characterScale = 1.0);
-MotionClipResult parseBvh(const std::string& text, const UrdfModelPtr& model, const BvhOptions& options = {},
-                          const JointMapping* mapping = nullptr, double characterScale = 1.0,
-                          const std::string& name = "bvh");
+CAPE_CHARACTER_API MotionClipResult readBvh(const std::string& path, const UrdfModelPtr& model,
+                                            const BvhOptions& options = {},
+                                            const JointMapping* mapping = nullptr,
+                                            double characterScale = 1.0);
+CAPE_CHARACTER_API MotionClipResult parseBvh(const std::string& text, const UrdfModelPtr& model,
+                                             const BvhOptions& options = {},
+                                             const JointMapping* mapping = nullptr,
+                                             double characterScale = 1.0, const std::string& name = "bvh");
 
 /// Any of the three by format (Auto: detectMotionFormat). BVH needs the model; CSV and DeepMimic ignore it.
 struct MotionLoadOptions {
@@ -110,8 +118,9 @@ struct MotionLoadOptions {
   DeepMimicOptions deepMimic;
   BvhOptions bvh;
 };
-MotionClipResult loadMotion(const std::string& path, const UrdfModelPtr& model,
-                            const MotionLoadOptions& options = {}, const JointMapping* mapping = nullptr,
-                            double characterScale = 1.0);
+CAPE_CHARACTER_API MotionClipResult loadMotion(const std::string& path, const UrdfModelPtr& model,
+                                               const MotionLoadOptions& options = {},
+                                               const JointMapping* mapping = nullptr,
+                                               double characterScale = 1.0);
 
 }  // namespace cape::character

@@ -10,6 +10,7 @@
 // frames stay rigid (rotation matrices stay orthonormal), so a link pose is always a proper rigid transform.
 #pragma once
 
+#include "cape/character/Export.h"
 #include "cape/character/Status.h"
 #include "cape/character/Urdf.h"
 
@@ -33,9 +34,9 @@ struct WorldShape {
 /// world of ROS and PyBullet (REP 103: x forward, y left, z up), which is that world turned by
 /// sceneToWorld(UpAxis::Z): a character at yaw 0 faces +X, and its URDF frame is the world's.
 enum class UpAxis : int { Y, Z };
-const char* toString(UpAxis up);
+CAPE_CHARACTER_API const char* toString(UpAxis up);
 
-class Skeleton {
+class CAPE_CHARACTER_API Skeleton {
  public:
   /// The rotation taking URDF axes (x forward, y left, z up) into the Y-up scene frame (x right, y up, z
   /// backward).

@@ -2,9 +2,13 @@
 // never crashes; it comes back as a Status with a code a program can test and a message meant for a person.
 #pragma once
 
+#include "cape/character/Export.h"
+
 #include <string>
 #include <utility>
 
+/// The character (library cape::character): a URDF humanoid (urdfdom) as a Skeleton with forward
+/// kinematics, its links as kinematic Bullet bodies, a procedural gait, motion clips, and where a cape hangs.
 namespace cape::character {
 
 enum class ErrorCode : int {
@@ -21,9 +25,9 @@ enum class ErrorCode : int {
   InvalidArgument,  ///< A non-finite value, a non-positive scale or time step, ...
 };
 
-const char* toString(ErrorCode code);
+CAPE_CHARACTER_API const char* toString(ErrorCode code);
 
-class Status {
+class CAPE_CHARACTER_API Status {
  public:
   Status() = default;  ///< Success.
   static Status success() { return Status(); }

@@ -7,6 +7,7 @@
 // into our error message or, for a model that loads, into warnings().
 #pragma once
 
+#include "cape/character/Export.h"
 #include "cape/character/Status.h"
 
 #include <Eigen/Geometry>
@@ -23,7 +24,7 @@ namespace cape::character {
 /// PyBullet, Drake and the MuJoCo converters write (urdfdom itself has none). A mesh element becomes a
 /// ConvexHull: the convex hull of the mesh file's vertices, simplified to a vertex budget (UrdfLoadOptions).
 enum class ShapeType : int { Sphere, Box, Cylinder, Capsule, ConvexHull };
-const char* toString(ShapeType type);
+CAPE_CHARACTER_API const char* toString(ShapeType type);
 
 /// One collision element of a link, in the link's frame.
 struct ShapeDesc {
@@ -45,7 +46,7 @@ struct ShapeDesc {
 /// humanoid has eight); urdfdom has none, so it is read as floating and marked spherical here. Its position
 /// is a rotation (Skeleton::setJointRotation), not a number.
 enum class JointType : int { Fixed, Revolute, Continuous, Prismatic, Floating, Planar, Spherical };
-const char* toString(JointType type);
+CAPE_CHARACTER_API const char* toString(JointType type);
 
 struct LinkDesc {
   std::string name;
@@ -145,7 +146,7 @@ struct UrdfLoadResult {
 };
 
 /// Shared and immutable once loaded: any number of Skeletons may use one model.
-class UrdfModel {
+class CAPE_CHARACTER_API UrdfModel {
  public:
   /// Reads and parses a URDF file. FileNotFound when the path is not a readable regular file; InvalidModel,
   /// before anything is read, when it is larger than options.limits.maxFileBytes.
@@ -192,6 +193,6 @@ class UrdfModel {
 /// quoted, comments, CDATA, processing instructions and a DOCTYPE allowed) nested at most
 /// UrdfLimits().maxXmlDepth deep. On failure `message` says what and on which line. Used before urdfdom so
 /// that broken XML is told apart from a broken robot description.
-bool checkXmlWellFormed(const std::string& text, std::string& message);
+CAPE_CHARACTER_API bool checkXmlWellFormed(const std::string& text, std::string& message);
 
 }  // namespace cape::character

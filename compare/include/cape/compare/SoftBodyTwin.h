@@ -7,6 +7,7 @@
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
+#include "cape/compare/Export.h"
 
 #include <BulletSoftBody/btDeformableLagrangianForce.h>
 #include <BulletSoftBody/btDeformableMultiBodyDynamicsWorld.h>
@@ -16,6 +17,8 @@
 #include <memory>
 #include <vector>
 
+/// The comparison's tools (library cape::compare_twins): Bullet's btSoftBody and deformable-world twins of a
+/// cape, for cape_compare and its tests.
 namespace cape::compare {
 
 struct SoftBodyTwinSettings {
@@ -44,8 +47,9 @@ struct SoftBodyTwinSettings {
 /// The caller owns it: world.removeSoftBody(twin.get()) before it is destroyed. Nodes are the cape's
 /// particles in order; links are appended family by family in the fabric's spring order; triangles are the
 /// fabric's (for drawing and aerodynamics).
-std::unique_ptr<btSoftBody> makeSoftBodyTwin(btSoftRigidDynamicsWorld& world, const bullet::CapeAction& cape,
-                                             const SoftBodyTwinSettings& settings = SoftBodyTwinSettings());
+CAPE_COMPARE_API std::unique_ptr<btSoftBody> makeSoftBodyTwin(
+    btSoftRigidDynamicsWorld& world, const bullet::CapeAction& cape,
+    const SoftBodyTwinSettings& settings = SoftBodyTwinSettings());
 
 /// The twin for Bullet's deformable world (btDeformableMultiBodyDynamicsWorld, Xuchen Han's solver of
 /// Bullet 3): the same nodes, masses, links, faces and anchors as makeSoftBodyTwin, driven by a mass-spring
@@ -71,7 +75,7 @@ struct DeformableTwinSettings {
 
 /// A deformable twin in its world; removes itself (body and forces) when destroyed, so it must not outlive
 /// the world.
-class DeformableTwin {
+class CAPE_COMPARE_API DeformableTwin {
  public:
   DeformableTwin(btDeformableMultiBodyDynamicsWorld& world, std::unique_ptr<btSoftBody> body,
                  std::vector<std::unique_ptr<btDeformableLagrangianForce>> forces);
@@ -89,7 +93,7 @@ class DeformableTwin {
 
 /// Builds the deformable twin of `cape` from its current state and attachments and adds it to `world`;
 /// nullptr if the cape is not ok. Anchors are Bullet's deformable anchors to the attachment bodies.
-std::unique_ptr<DeformableTwin> makeDeformableTwin(
+CAPE_COMPARE_API std::unique_ptr<DeformableTwin> makeDeformableTwin(
     btDeformableMultiBodyDynamicsWorld& world, const bullet::CapeAction& cape,
     const DeformableTwinSettings& settings = DeformableTwinSettings());
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "cape/core/Cape.h"
+#include "cape/scenes/Export.h"
 
 #include <cstdint>
 #include <vector>
@@ -17,33 +18,33 @@ struct StrainStats {
   float mean = 0.0f;  ///< mean of the same (signed)
 };
 /// Strain of the structural springs at the given positions; 0 and 0 for a fabric with none.
-StrainStats structuralStrain(const Fabric& fabric, const Points& positions);
+CAPE_SCENES_API StrainStats structuralStrain(const Fabric& fabric, const Points& positions);
 
 /// Penetration: max over particles and colliders of max(0, -signed distance to the true surface) at each
 /// collider's current pose, m. Invalid colliders are skipped.
-float maxPenetration(const Points& positions, ColliderSpan colliders);
+CAPE_SCENES_API float maxPenetration(const Points& positions, ColliderSpan colliders);
 
 /// Pin error: the largest distance of a pinned particle from its current target (`Pin::target`), m.
-float maxPinError(const Points& positions, const std::vector<Pin>& pins);
+CAPE_SCENES_API float maxPinError(const Points& positions, const std::vector<Pin>& pins);
 /// The same over a cape's state and its pins.
-float maxPinError(const CapeState& state);
+CAPE_SCENES_API float maxPinError(const CapeState& state);
 
 /// Blow-up: a non-finite coordinate, or a particle farther than `radius` from `centre`.
-bool isBlownUp(const Points& positions, const Vec3& centre, float radius = 10.0f);
+CAPE_SCENES_API bool isBlownUp(const Points& positions, const Vec3& centre, float radius = 10.0f);
 
 /// Exact triangle-triangle intersection test (Möller 1997 interval test, evaluated in double precision with
 /// no tolerance; touching counts as intersecting; coplanar triangles are tested in 2D). Triangles whose
 /// bounding boxes are apart never intersect: tested first, as the interval test alone reports such pairs as
 /// crossing when a triangle is degenerate (its corners on a line) or the two normals are parallel in double
 /// while rounding puts each triangle across the other's plane.
-bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& q0, const Vec3& q1,
-                        const Vec3& q2);
+CAPE_SCENES_API bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& q0,
+                                        const Vec3& q1, const Vec3& q2);
 
 /// Counts pairs of triangles that share no vertex and intersect: the pairs whose bounding boxes overlap
 /// (closed boxes, as `trianglesIntersect` counts touching) found through a uniform spatial hash, each pair
 /// tested once with the exact test, so the count is the brute-force count over all pairs. Reuses its scratch
 /// between calls (one counter per cape: no allocation once it has seen the cape's size).
-class SelfIntersectionCounter {
+class CAPE_SCENES_API SelfIntersectionCounter {
  public:
   int count(const Fabric& fabric, const Points& positions);
 
@@ -94,16 +95,18 @@ struct FrameMetrics {
 /// previous target is not read); `bodyColliders` are at this frame's poses; `torsoCentre` is where the
 /// blow-up radius is measured from. A blown-up frame only says so (`blowUp`; every other figure left 0, as
 /// they would be NaN or meaningless). Self-intersections are only counted when a counter is given.
-FrameMetrics measureFrame(const Fabric& fabric, const Points& positions, const Points& velocities,
-                          const std::vector<Pin>& pins, ColliderSpan bodyColliders, const Vec3& torsoCentre,
-                          SelfIntersectionCounter* selfIntersections);
+CAPE_SCENES_API FrameMetrics measureFrame(const Fabric& fabric, const Points& positions,
+                                          const Points& velocities, const std::vector<Pin>& pins,
+                                          ColliderSpan bodyColliders, const Vec3& torsoCentre,
+                                          SelfIntersectionCounter* selfIntersections);
 /// Our cape's frame: the function above on its fabric, its state and its pins.
-FrameMetrics measureFrame(const Cape& cape, ColliderSpan bodyColliders, const Vec3& torsoCentre,
-                          SelfIntersectionCounter* selfIntersections);
+CAPE_SCENES_API FrameMetrics measureFrame(const Cape& cape, ColliderSpan bodyColliders,
+                                          const Vec3& torsoCentre,
+                                          SelfIntersectionCounter* selfIntersections);
 
 /// The worst of two frames, metric by metric (the larger strain, penetration, count, pin error and speed;
 /// blown up if either is): a crowd's row holds the worst of its characters.
-FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b);
+CAPE_SCENES_API FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b);
 
 struct RunSummary {
   std::int64_t frames = 0;
@@ -132,7 +135,7 @@ struct RunSummary {
 /// <= |q| <= kLargest, by at most kSmallest when |q| < kSmallest (such values count as 0), and always lies
 /// between the smallest and the largest value seen, which are kept exactly (the 0th and 100th percentiles are
 /// exact). NaN values are not counted.
-class PercentileEstimator {
+class CAPE_SCENES_API PercentileEstimator {
  public:
   static constexpr std::size_t kExactValues = 4096;
   static constexpr double kRelativeError = 0.005;
@@ -159,7 +162,7 @@ class PercentileEstimator {
 
 /// Accumulates frames into a summary, in constant memory: running extrema, counts and sums, the per-frame max
 /// strain in a PercentileEstimator, and the mean speeds of the last second.
-class MetricsRecorder {
+class CAPE_SCENES_API MetricsRecorder {
  public:
   explicit MetricsRecorder(double frameTime = 1.0 / 60.0);
   void add(const FrameMetrics& m);
@@ -174,6 +177,6 @@ class MetricsRecorder {
 };
 
 /// Median and p-th percentile (nearest rank) of a list of values; 0 for an empty list.
-double percentile(std::vector<double> values, double p);
+CAPE_SCENES_API double percentile(std::vector<double> values, double p);
 
 }  // namespace cape

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "cape/core/Cape.h"
+#include "cape/scenes/Export.h"
 
 #include <string>
 #include <vector>
@@ -10,18 +11,18 @@
 namespace cape {
 
 enum class SceneKind : int { Hang, Walk, SprintTurn, Wind, Crowd };
-const char* toString(SceneKind kind);
+CAPE_SCENES_API const char* toString(SceneKind kind);
 /// Parses "hang", "walk", "sprint-turn", "wind", "crowd"; false if unknown.
-bool parseSceneKind(const std::string& name, SceneKind& kind);
+CAPE_SCENES_API bool parseSceneKind(const std::string& name, SceneKind& kind);
 
 /// Which cape particles are pinned (docs/SCENES.md's attachment): the two top corners, or the whole top row.
 enum class PinLayout : int { Corners, Collar };
-const char* toString(PinLayout layout);
+CAPE_SCENES_API const char* toString(PinLayout layout);
 /// Parses "corners", "collar"; false if unknown.
-bool parsePinLayout(const std::string& name, PinLayout& layout);
+CAPE_SCENES_API bool parsePinLayout(const std::string& name, PinLayout& layout);
 
 /// How the character moves in a scene. Times in s, lengths in m, angles in rad.
-struct MotionDesc {
+struct CAPE_SCENES_API MotionDesc {
   float speed = 0.0f;            ///< m/s along the heading
   float legFrequency = 0.0f;     ///< Hz, one full leg swing per period
   float legAmplitude = 0.5236f;  ///< rad (30 degrees)
@@ -37,13 +38,13 @@ struct MotionDesc {
 
 /// The scene's wind: for "wind", the aerodynamic model at 8 m/s mean along +X with gusts of +-50 % (0.5 Hz,
 /// 2 m turbulence); no wind in every other scene.
-WindSettings sceneWind(SceneKind kind);
+CAPE_SCENES_API WindSettings sceneWind(SceneKind kind);
 /// `settings` with the scene's wind filled in when the settings name none (an explicit wind wins).
-CapeSettings settingsForScene(SceneKind kind, CapeSettings settings);
+CAPE_SCENES_API CapeSettings settingsForScene(SceneKind kind, CapeSettings settings);
 
 /// The character's pose at a time: its frame (origin on the ground between the feet, facing -Z when yaw = 0),
 /// the torso bob and the left leg angle (the right leg is its negative).
-struct BodyPose {
+struct CAPE_SCENES_API BodyPose {
   Vec3 position = Vec3::Zero();
   float yaw = 0.0f;  ///< rad about +Y
   float bob = 0.0f;  ///< m, added to every body part's height
@@ -52,11 +53,11 @@ struct BodyPose {
 };
 
 /// Exact pose at time t (closed form, independent of the step size).
-BodyPose motionAt(const MotionDesc& motion, double t);
+CAPE_SCENES_API BodyPose motionAt(const MotionDesc& motion, double t);
 
 /// The simple body of docs/SCENES.md: torso box, shoulder spheres, leg capsules and the ground plane.
 /// Collider order: torso, left shoulder, right shoulder, left leg, right leg, ground.
-class SimpleBody {
+class CAPE_SCENES_API SimpleBody {
  public:
   static constexpr int kTorso = 0, kLeftShoulder = 1, kRightShoulder = 2, kLeftLeg = 3, kRightLeg = 4,
                        kGround = 5;
@@ -88,13 +89,14 @@ struct CapeSize {
 };
 /// The N x N cape (the canonical 0.6 m x 1.0 m, 0.4 kg; another size keeps its mass per area) with tethers
 /// to its attachment particles, its top row centred on the canonical pin line.
-CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings = true, const CapeSize& size = CapeSize());
+CAPE_SCENES_API CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings = true,
+                                    const CapeSize& size = CapeSize());
 /// The cape's starting placement in the character frame: flat and vertical at z = 0.15 with its top row on
 /// the pins, or for "hang" flat and horizontal reaching from the pins towards +Z.
-Pose capeStartPlacement(SceneKind kind, const CapeSize& size = CapeSize());
+CAPE_SCENES_API Pose capeStartPlacement(SceneKind kind, const CapeSize& size = CapeSize());
 
 /// One cape on the simple body, stepped frame by frame: what tests and benchmarks run.
-class SimpleScene {
+class CAPE_SCENES_API SimpleScene {
  public:
   SimpleScene(SceneKind kind, int n, PinLayout layout, const CapeSettings& settings,
               const Vec3& offset = Vec3::Zero());

@@ -24,6 +24,7 @@
 // deleted body's address is taken for it: detach(body) before deleting a body that another may replace.)
 #pragma once
 
+#include "cape/bullet/Export.h"
 #include "cape/bullet/ShapeColliders.h"
 #include "cape/core/Cape.h"
 
@@ -95,7 +96,7 @@ struct Attachment {
   btVector3 localPivot{0, 0, 0};      ///< m, in the body's frame.
 };
 
-class CapeAction : public btActionInterface {
+class CAPE_BULLET_API CapeAction : public btActionInterface {
  public:
   static constexpr std::uint32_t kNoParticle = 0xffffffffu;
 

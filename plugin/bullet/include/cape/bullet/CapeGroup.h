@@ -6,6 +6,7 @@
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
+#include "cape/bullet/Export.h"
 
 #include <condition_variable>
 #include <mutex>
@@ -14,7 +15,7 @@
 
 namespace cape::bullet {
 
-class CapeGroup : public btActionInterface {
+class CAPE_BULLET_API CapeGroup : public btActionInterface {
  public:
   /// threadCount >= 1 workers in all, the calling thread included (threadCount - 1 threads are started).
   explicit CapeGroup(int threadCount = 1);

@@ -6,6 +6,8 @@
 
 #include <LinearMath/btTransform.h>
 
+/// The Bullet adapter (library cape::bullet): CapeAction and CapeGroup step capes with a Bullet world, and
+/// Bullet shapes become core colliders. Bullet's types (btScalar, btVector3, btTransform) in metres.
 namespace cape::bullet {
 
 inline Vec3 toVec3(const btVector3& v) {

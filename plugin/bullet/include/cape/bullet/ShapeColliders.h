@@ -7,6 +7,7 @@
 // per step.
 #pragma once
 
+#include "cape/bullet/Export.h"
 #include "cape/core/Collider.h"
 
 #include <BulletCollision/CollisionShapes/btCollisionShape.h>
@@ -46,30 +47,31 @@ struct ShapeConversion {
 /// (exact for uniform scaling); a btStaticPlaneShape's scaling is ignored (a plane has no size).
 /// A btMultiSphereShape is the convex hull of its spheres: its spheres are core colliders, and its sampled
 /// hull keeps particles out of the space between them.
-ShapeConversion convertShape(const btCollisionShape* shape,
-                             const btTransform& local = btTransform::getIdentity());
+CAPE_BULLET_API ShapeConversion convertShape(const btCollisionShape* shape,
+                                             const btTransform& local = btTransform::getIdentity());
 
 /// The core convex hull of a convex shape without its margin (a btPolyhedralConvexShape's vertices, scaled;
 /// any other shape's support points without margin in 162 directions spread over the sphere), through
 /// Bullet's btConvexHullComputer; the shape's margin is for the collider's thickness. nullptr for a flat
 /// or degenerate shape (fewer than four points off one plane).
-std::shared_ptr<const ConvexHull> convexHullOf(const btConvexShape* shape);
+CAPE_BULLET_API std::shared_ptr<const ConvexHull> convexHullOf(const btConvexShape* shape);
 
 /// Signed distance from a world point to a convex shape's true surface (margin included), m, negative
 /// inside, and the outward unit normal at the nearest surface point. Uses Bullet's GJK (outside and within
 /// the margin) and EPA (deeper inside). Returns false when GJK/EPA fails (the outputs are then unchanged).
-bool convexSignedDistance(const btConvexShape* shape, const btTransform& world, const btVector3& point,
-                          btScalar& distance, btVector3& normal);
+CAPE_BULLET_API bool convexSignedDistance(const btConvexShape* shape, const btTransform& world,
+                                          const btVector3& point, btScalar& distance, btVector3& normal);
 
 /// Signed distance from a world point to any shape this adapter understands, m (the minimum over a
 /// compound's children; triangle meshes give the unsigned distance to the nearest triangle minus the shape
 /// margin). For metrics and tests: the "true Bullet surface" of docs/SCENES.md's penetration metric.
 /// Returns +infinity for shapes it cannot measure.
-btScalar shapeSignedDistance(const btCollisionShape* shape, const btTransform& world, const btVector3& point);
+CAPE_BULLET_API btScalar shapeSignedDistance(const btCollisionShape* shape, const btTransform& world,
+                                             const btVector3& point);
 
 /// The point of triangle abc nearest to p (cape::nearestOnTriangle in Bullet's types); `onFace`, when given,
 /// says whether it lies inside the face rather than on an edge or a corner.
-btVector3 closestOnTriangle(const btVector3& p, const btVector3& a, const btVector3& b, const btVector3& c,
-                            bool* onFace = nullptr);
+CAPE_BULLET_API btVector3 closestOnTriangle(const btVector3& p, const btVector3& a, const btVector3& b,
+                                            const btVector3& c, bool* onFace = nullptr);
 
 }  // namespace cape::bullet

@@ -6,6 +6,7 @@
 #include "cape/core/CapeSettings.h"
 #include "cape/core/CapeState.h"
 #include "cape/core/Collider.h"
+#include "cape/core/Export.h"
 #include "cape/core/Fabric.h"
 
 #include <array>
@@ -30,7 +31,7 @@ struct ColliderSpan {
   const Collider* end() const { return data + size; }
 };
 
-class Cape {
+class CAPE_CORE_API Cape {
  public:
   /// Makes a cape at the fabric's rest shape placed by `placement` (world = placement * rest), at rest.
   /// Check `status()`: on bad settings or fabric the cape is empty and step() does nothing.

@@ -3,11 +3,12 @@
 // two-sided shading (back faces with flipped winding and flipped normals).
 #pragma once
 
+#include "cape/core/Export.h"
 #include "cape/core/Fabric.h"
 
 namespace cape {
 
-struct CapeMesh {
+struct CAPE_CORE_API CapeMesh {
   Points positions;  ///< m, one row per vertex.
   Points normals;    ///< Unit, one row per vertex.
   std::vector<Eigen::Vector2f> uvs;
@@ -28,7 +29,7 @@ struct CapeMesh {
 /// Area-weighted vertex normals: the normalised sum of the (unnormalised) face normals of the triangles
 /// around each vertex, whose length is twice the triangle's area. Writes into `normals` (sized by the
 /// caller).
-void computeVertexNormals(const Points& positions, const std::vector<std::uint32_t>& triangles,
-                          Eigen::Ref<Points, 0, Eigen::OuterStride<>> normals);
+CAPE_CORE_API void computeVertexNormals(const Points& positions, const std::vector<std::uint32_t>& triangles,
+                                        Eigen::Ref<Points, 0, Eigen::OuterStride<>> normals);
 
 }  // namespace cape

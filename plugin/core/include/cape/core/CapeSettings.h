@@ -1,6 +1,7 @@
 // CapeSettings: per-cape parameters, plain data with units. Checked by validate() before every run.
 #pragma once
 
+#include "cape/core/Export.h"
 #include "cape/core/Types.h"
 
 namespace cape {
@@ -16,7 +17,7 @@ enum class Integrator : int {
   /// stability bound.
   ExplicitSpring = 1,
 };
-const char* toString(Integrator integrator);
+CAPE_CORE_API const char* toString(Integrator integrator);
 
 /// Wind acting on the cape (the aerodynamic model lives with the solver; this is its data).
 struct WindSettings {
@@ -33,7 +34,7 @@ struct WindSettings {
   unsigned seed = 1;               ///< Seeds the deterministic gust field.
 };
 
-struct CapeSettings {
+struct CAPE_CORE_API CapeSettings {
   Integrator integrator = Integrator::Xpbd;
 
   /// Spring stiffness per family, N/m per spring (Hooke's k). XPBD uses the compliance 1/k; infinity means

@@ -1,6 +1,7 @@
 // CapeState: the per-cape runtime state as structure of arrays.
 #pragma once
 
+#include "cape/core/Export.h"
 #include "cape/core/Types.h"
 
 #include <cstdint>
@@ -26,6 +27,6 @@ struct CapeState {
 
 /// FNV-1a over the bits of the positions and then the velocities: equal states give equal hashes, and a
 /// refactor that keeps the solver's arithmetic keeps them (the tests store hashes of the canonical scenes).
-std::uint64_t stateHash(const CapeState& state);
+CAPE_CORE_API std::uint64_t stateHash(const CapeState& state);
 
 }  // namespace cape

@@ -4,6 +4,7 @@
 // through.
 #pragma once
 
+#include "cape/core/Export.h"
 #include "cape/core/Types.h"
 
 #include <memory>
@@ -13,12 +14,12 @@
 namespace cape {
 
 enum class ColliderShape : int { Sphere, Capsule, Cylinder, Box, Plane, ConvexHull, TriangleMesh };
-const char* toString(ColliderShape shape);
+CAPE_CORE_API const char* toString(ColliderShape shape);
 
 /// A convex polytope in its collider's frame: the points it is the hull of, and its outward face planes
 /// n . p = offset (n a unit vector; the solid is where every n . p <= offset). Built once and shared by every
 /// collider (and every cape) that uses it; the Bullet adapter builds it from any convex shape.
-struct ConvexHull {
+struct CAPE_CORE_API ConvexHull {
   std::vector<Vec3> vertices;           ///< m, at least 4, not all in one plane.
   std::vector<Eigen::Vector4f> planes;  ///< (n.x, n.y, n.z, offset in m), at least 4.
   float radius = 0.0f;                  ///< m: the largest |vertex| (a bounding sphere about the origin).
@@ -52,7 +53,7 @@ struct TriangleSoup {
 ///   TriangleMesh  `triangles`, two-sided: each particle keeps the side of every nearby triangle it was on
 ///                 at the start of the step (so a thin wall or a floor cannot be passed through), at least
 ///                 the thicknesses away from it; no inside
-struct Collider {
+struct CAPE_CORE_API Collider {
   ColliderShape shape = ColliderShape::Sphere;
   float radius = 0.0f;
   float halfHeight = 0.0f;
@@ -96,13 +97,13 @@ struct SurfaceDistance {
   float distance;
   Vec3 normal;
 };
-SurfaceDistance localSignedDistance(const Collider& collider, const Vec3& localPoint);
+CAPE_CORE_API SurfaceDistance localSignedDistance(const Collider& collider, const Vec3& localPoint);
 
 /// Signed distance from a world point to the collider's true surface at its current pose.
-float signedDistance(const Collider& collider, const Vec3& worldPoint);
+CAPE_CORE_API float signedDistance(const Collider& collider, const Vec3& worldPoint);
 
 /// The nearest point of the collider's surface to a world point, at its current pose (the seed's push-out
 /// target when the thickness is zero).
-Vec3 closestSurfacePoint(const Collider& collider, const Vec3& worldPoint);
+CAPE_CORE_API Vec3 closestSurfacePoint(const Collider& collider, const Vec3& worldPoint);
 
 }  // namespace cape

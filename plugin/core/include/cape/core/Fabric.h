@@ -2,6 +2,7 @@
 // SoftBodySharedSettings). Many capes may share one Fabric; per-cape data lives in CapeState.
 #pragma once
 
+#include "cape/core/Export.h"
 #include "cape/core/Types.h"
 
 #include <memory>
@@ -14,7 +15,7 @@ namespace cape {
 /// The families of springs. Structural and shear together form the seed's King's graph for a grid.
 enum class SpringFamily : int { Structural = 0, Shear = 1, Bend = 2 };
 constexpr int kSpringFamilyCount = 3;
-const char* toString(SpringFamily family);
+CAPE_CORE_API const char* toString(SpringFamily family);
 
 /// How the solver reads the particles of a run of springs. Every block of four consecutive springs of one
 /// colour is solved four at a time: with vector loads and stores of whole neighbourhoods where the indices
@@ -119,7 +120,7 @@ struct FabricResult {
   explicit operator bool() const { return fabric != nullptr; }
 };
 
-class Fabric {
+class CAPE_CORE_API Fabric {
  public:
   /// Builds an N x M grid in its local frame: particle (r, c) has index r * columns + c and rest position
   /// (c * width / (columns - 1), -r * height / (rows - 1), 0): row-major from the top-left seen from +Z.

@@ -1,6 +1,7 @@
 // Small geometric queries shared by the core and the Bullet adapter.
 #pragma once
 
+#include "cape/core/Export.h"
 #include "cape/core/Types.h"
 
 namespace cape {
@@ -13,6 +14,6 @@ struct TriangleNearest {
   float wa, wb, wc;
   bool inFace;
 };
-TriangleNearest nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+CAPE_CORE_API TriangleNearest nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
 }  // namespace cape

@@ -1,6 +1,8 @@
 // Basic types of the cape core: vectors, poses and the status value that reports bad input.
 #pragma once
 
+#include "cape/core/Export.h"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -9,6 +11,9 @@
 #include <utility>
 #include <vector>
 
+/// CapeCloth. The solver core (cape/core: Eigen only, no Bullet, no I/O, no threads), the canonical scenes
+/// and their metrics (cape/scenes) and the simple body as Bullet bodies (cape/scenes/BulletSimpleBody.h).
+/// Lengths are metres, times seconds, masses kilograms, angles radians.
 namespace cape {
 
 using Vec3 = Eigen::Vector3f;
@@ -20,7 +25,7 @@ using Quat = Eigen::Quaternionf;
 using Points = Eigen::Matrix<float, Eigen::Dynamic, 3>;
 
 /// A rigid transform: x_world = rotation * x_local + position. Units: metres.
-struct Pose {
+struct CAPE_CORE_API Pose {
   Vec3 position = Vec3::Zero();
   Quat rotation = Quat::Identity();  ///< Unit quaternion.
 
@@ -34,7 +39,7 @@ struct Pose {
 };
 
 /// The result of an operation that can fail on bad data: ok, or an error message meant for a person.
-class Status {
+class CAPE_CORE_API Status {
  public:
   static Status success() { return Status(); }
   static Status error(std::string message) { return Status(std::move(message)); }

@@ -11,18 +11,19 @@
 #pragma once
 
 #include "cape/core/CapeSettings.h"
+#include "cape/core/Export.h"
 
 namespace cape {
 
 /// The air's velocity at a world point and time, m/s. Deterministic: the same settings (seed included), point
 /// and time give the same bits. Zero for Model::None.
-Vec3 windVelocity(const WindSettings& wind, const Vec3& point, double time);
+CAPE_CORE_API Vec3 windVelocity(const WindSettings& wind, const Vec3& point, double time);
 
 /// The same at many points at once (vectorised), one row per point; `out` must have as many rows as `points`.
 /// The points may be given in a frame whose origin is the world point `origin` (a cape's frame,
 /// Cape::origin): the field is the world's, its phases taken at origin + point in double.
-void windVelocities(const WindSettings& wind, const Points& points, double time, Points& out,
-                    const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
+CAPE_CORE_API void windVelocities(const WindSettings& wind, const Points& points, double time, Points& out,
+                                  const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
 
 /// The aerodynamic force on one triangle, N (Model::Aerodynamic). `relativeAir` is the air's velocity
 /// relative to the triangle, u (m/s); `areaNormal` is the triangle's normal scaled by its area, A n (m^2;
@@ -32,7 +33,7 @@ void windVelocities(const WindSettings& wind, const Points& points, double time,
 ///   lift  F_l = q Cl A |u| (u . n) (n - (n . u^) u^)         (perpendicular to u, |F_l| = q Cl A |u|^2 cos
 ///   sin)
 /// so that a plate broadside to the flow feels pure drag and one edge-on feels nothing.
-Vec3 aerodynamicForce(const Vec3& relativeAir, const Vec3& areaNormal, float airDensity,
-                      float dragCoefficient, float liftCoefficient);
+CAPE_CORE_API Vec3 aerodynamicForce(const Vec3& relativeAir, const Vec3& areaNormal, float airDensity,
+                                    float dragCoefficient, float liftCoefficient);
 
 }  // namespace cape

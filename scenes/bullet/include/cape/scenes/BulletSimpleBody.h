@@ -5,6 +5,7 @@
 // order.
 #pragma once
 
+#include "cape/scenes/BulletExport.h"
 #include "cape/scenes/Scene.h"
 
 #include <btBulletDynamicsCommon.h>
@@ -14,7 +15,7 @@
 
 namespace cape {
 
-class BulletSimpleBody {
+class CAPE_SCENES_BULLET_API BulletSimpleBody {
  public:
   /// Places the simple body standing at `offset` in `pose` (teleported: no sweep) and adds one kinematic,
   /// never-sleeping btRigidBody per body collider to `world`, in SimpleBody's order (kTorso, kLeftShoulder,
