@@ -1,7 +1,8 @@
-// Where a cape hangs on a character that nobody described to us: the links its shoulders hang from, the
-// shoulder points, the upper torso, and how far its back lies behind the shoulders. Found from the joint
-// mapping (the joints it takes for the shoulders) and the collision shapes, so any URDF humanoid whose
-// shoulders are mapped gets a cape without naming a link.
+/// \file
+/// Where a cape hangs on a character that nobody described to us: the links its shoulders hang from, the
+/// shoulder points, the upper torso, and how far its back lies behind the shoulders. Found from the joint
+/// mapping (the joints it takes for the shoulders) and the collision shapes, so any URDF humanoid whose
+/// shoulders are mapped gets a cape without naming a link.
 #pragma once
 
 #include "cape/character/Character.h"
@@ -15,18 +16,19 @@
 
 namespace cape::character {
 
+/// Where a cape hangs on a character: the links, the shoulder points and the back (see Anchors.h).
 struct ShoulderAnchors {
   Status status;  ///< an error (NotMovable, UnknownLink) when no shoulders could be found
   /// The links the shoulders hang from, each the nearest link (walking to the root) that has a body: the
   /// shipped humanoid's left_shoulder / right_shoulder, or a robot's torso.
   int leftLink = -1;
-  int rightLink = -1;
+  int rightLink = -1;  ///< the right shoulder's link (see leftLink)
   /// Their nearest common ancestor with a body (the upper torso): what a collar pins to.
   int upperTorsoLink = -1;
   /// The shoulder joints' centres in the Y-up scene frame of docs/SCENES.md (the world turned back by
   /// Skeleton::sceneToWorld: x right and y up for a character at yaw 0, the ground at y = 0), m.
   Eigen::Vector3d left = Eigen::Vector3d::Zero();
-  Eigen::Vector3d right = Eigen::Vector3d::Zero();
+  Eigen::Vector3d right = Eigen::Vector3d::Zero();  ///< the right shoulder's centre, m (see left)
   /// m: how far behind the shoulders' centre (+Z) the back's surface is, around shoulder height (the largest
   /// +Z of the shapes of the upper torso and its ancestors within 40 cm below the shoulders).
   double back = 0.0;

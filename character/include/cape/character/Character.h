@@ -1,23 +1,26 @@
-// One walking character in a Bullet world: a Skeleton posed by a Gait through a JointMapping, and its
-// CharacterBodies. The short way to run a scene:
-//
-//   auto model = cape::character::UrdfModel::humanoid();            // or UrdfModel::fromFile(path)
-//   if (!model.ok()) { print(model.status.message()); return; }
-//   auto made = cape::character::Character::create(model.model, world,
-//                                                  cape::character::Gait::forScene(cape::SceneKind::Walk));
-//   for (const std::string& w : made.character->warnings()) print(w);
-//   btRigidBody* leftShoulder = made.character->bodies().bodyForLink("left_shoulder");
-//   std::printf("root %.3f m above the ground\n", made.character->rootHeight());
-//   for (int frame = 1; frame <= 600; ++frame) {
-//     made.character->advanceTo(frame / 60.0);  // poses the skeleton, moves the bodies (velocities too)
-//     world.stepSimulation(1 / 60.f, 8, 1 / 240.f);
-//     made.character->skeleton().worldShapes(shapes);  // colliders to export: link, type, sizes, world pose
-//   }
-//
-// It stands on the ground: its root goes where the lowest collision point of its standing pose touches
-// world y = 0 (Grounding.h), or at CharacterSettings::rootHeight. A floating base (a root at the pelvis, a
-// floating joint, a dummy "world" link) is said in warnings(). CharacterSettings::pose gives it a starting
-// pose; parsePose reads one from text.
+/// \file
+/// One walking character in a Bullet world: a Skeleton posed by a Gait through a JointMapping, and its
+/// CharacterBodies. The short way to run a scene:
+///
+/// \code{.cpp}
+///   auto model = cape::character::UrdfModel::humanoid();            // or UrdfModel::fromFile(path)
+///   if (!model.ok()) { print(model.status.message()); return; }
+///   auto made = cape::character::Character::create(model.model, world,
+///                                                  cape::character::Gait::forScene(cape::SceneKind::Walk));
+///   for (const std::string& w : made.character->warnings()) print(w);
+///   btRigidBody* leftShoulder = made.character->bodies().bodyForLink("left_shoulder");
+///   std::printf("root %.3f m above the ground\n", made.character->rootHeight());
+///   for (int frame = 1; frame <= 600; ++frame) {
+///     made.character->advanceTo(frame / 60.0);  // poses the skeleton, moves the bodies (velocities too)
+///     world.stepSimulation(1 / 60.f, 8, 1 / 240.f);
+///     made.character->skeleton().worldShapes(shapes);  // colliders to export: link, type, sizes, world pose
+///   }
+/// \endcode
+///
+/// It stands on the ground: its root goes where the lowest collision point of its standing pose touches
+/// world y = 0 (Grounding.h), or at CharacterSettings::rootHeight. A floating base (a root at the pelvis, a
+/// floating joint, a dummy "world" link) is said in warnings(). CharacterSettings::pose gives it a starting
+/// pose; parsePose reads one from text.
 #pragma once
 
 #include "cape/character/CharacterBodies.h"
@@ -40,6 +43,8 @@ using JointPose = std::vector<std::pair<std::string, double>>;
 /// Rotations of spherical joints by name (see Skeleton::setJointRotation).
 using JointRotations = std::vector<std::pair<std::string, Eigen::Quaterniond>>;
 
+/// How Character::create builds a character: scale, where it stands, its bodies, the world's up axis, its
+/// root height and starting pose.
 struct CharacterSettings {
   double scale = 1.0;                                ///< uniform scale of the URDF, > 0
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();  ///< m, world, added to the gait's root path (a crowd)
@@ -65,12 +70,16 @@ struct CharacterSettings {
 CAPE_CHARACTER_API Status parsePose(const std::string& text, JointPose& out);
 
 class Character;
+/// What Character::create returns: ok and a character, or an error status and none.
 struct CharacterResult {
-  Status status;
-  std::unique_ptr<Character> character;
+  Status status;                         ///< Why there is no character, or success
+  std::unique_ptr<Character> character;  ///< The character; null on error
+  /// True when a character was made.
   bool ok() const { return status.ok() && character != nullptr; }
 };
 
+/// One walking character in a Bullet world: a Skeleton posed by a Gait (or the user's motion, or a clip)
+/// through a JointMapping, and its CharacterBodies (see Character.h for the short way to run a scene).
 class CAPE_CHARACTER_API Character {
  public:
   /// Builds the skeleton (joints mapped with JointMapping::automatic, unless `mapping` is given), applies the
@@ -85,6 +94,7 @@ class CAPE_CHARACTER_API Character {
   /// Poses the skeleton at time t (s) and moves the bodies there, with velocities over t - time(). A t not
   /// after time() is a jump (teleport, zero velocity). Call before stepping the world.
   void advanceTo(double t);
+  /// s: the time of the last pose.
   double time() const { return time_; }
 
   /// The user's own motion at time t (s), from a controller or an animation system, instead of the gait:
@@ -106,11 +116,17 @@ class CAPE_CHARACTER_API Character {
   Character(const Character&) = delete;  // the bodies point at this skeleton: not copyable, not movable
   Character& operator=(const Character&) = delete;
 
+  /// The posed skeleton.
   const Skeleton& skeleton() const { return skeleton_; }
+  /// The character's Bullet bodies.
   CharacterBodies& bodies() { return *bodies_; }
+  /// The character's Bullet bodies.
   const CharacterBodies& bodies() const { return *bodies_; }
+  /// The gait advanceTo() follows.
   const Gait& gait() const { return gait_; }
+  /// Which joint plays each role of the gait.
   const JointMapping& mapping() const { return mapping_; }
+  /// The settings it was made with.
   const CharacterSettings& settings() const { return settings_; }
   /// m: the height of the URDF root link origin above the ground that was chosen (CharacterSettings::
   /// rootHeight, or the automatic one); the gait's bob and the offset come on top.

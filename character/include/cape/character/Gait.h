@@ -1,28 +1,31 @@
-// A procedural walking (or running) gait: a closed-form function of time, so any frame can be posed directly,
-// with no state and no dependence on the step size.
-//
-// Root motion. The character frame (origin on the ground between the feet, facing -Z at yaw 0) follows the
-// canonical scenes exactly: for a scene, or for any gait that does not turn, it is the scenes' (cape::scenes)
-// cape::motionAt(MotionDesc, t) (docs/SCENES.md: walk at 1.4 m/s, sprint-turn at 5 m/s with a 180 degree
-// turn in the last 0.5 s of every 2 s), with the torso bob added to the root height, as the simple body does.
-// A gait with a constant turn rate w follows the exact arc: yaw = w t, and with forward = (-sin yaw, 0, -cos
-// yaw), position = (v/w (cos w t - 1), 0, -v/w sin w t). (Character lifts this path by its root height, so
-// that a model whose root is not on the ground stands on it.)
-//
-// Joint angles, anatomical (see JointMapping.h), with phase p = 2 pi f t:
-//   hip       left  A sin p                        right  -A sin p   (docs/SCENES.md: A = 0.5236 rad)
-//   knee      left  k0 + K max(0, cos p)^2         right  k0 + K max(0, -cos p)^2
-//             (the knee bends while its leg swings forward, most at mid-swing; C1-smooth)
-//   ankle     a (knee - hip): a = 1 keeps the foot level, a < 1 lets it follow the shin a little
-//   shoulder  left  -S sin p                       right  S sin p    (arms swing against the legs)
-//   elbow     left  E0 + E1 (1 - sin p) / 2        right  E0 + E1 (1 + sin p) / 2 (more bent when forward)
-//   shoulder roll  both  O + Os sin^2 p           (arms held a little away from the body, a little further
-//                                                  out at each end of their swing)
-// then joint position = neutral + sign * angle, clamped to the joint's limits (see JointMapping.h: the
-// neutral is 0, but the shoulder roll's, which hangs the arm down; when the neutral is 0 the position is
-// exactly sign * angle). Every angle is a function of p alone, so the joint trajectories repeat every 1/f
-// seconds (and the bob too when its frequency is a multiple of f). With f = 0 (standing) every angle is 0
-// but the shoulder roll's O: the standing pose (standingAngles), the rest pose with the arms down.
+/// \file
+/// A procedural walking (or running) gait: a closed-form function of time, so any frame can be posed
+/// directly, with no state and no dependence on the step size.
+///
+/// Root motion. The character frame (origin on the ground between the feet, facing -Z at yaw 0) follows the
+/// canonical scenes exactly: for a scene, or for any gait that does not turn, it is the scenes'
+/// (cape::scenes) cape::motionAt(MotionDesc, t) (docs/SCENES.md: walk at 1.4 m/s, sprint-turn at 5 m/s with a
+/// 180 degree turn in the last 0.5 s of every 2 s), with the torso bob added to the root height, as the
+/// simple body does. A gait with a constant turn rate w follows the exact arc: yaw = w t, and with forward =
+/// (-sin yaw, 0, -cos yaw), position = (v/w (cos w t - 1), 0, -v/w sin w t). (Character lifts this path by
+/// its root height, so that a model whose root is not on the ground stands on it.)
+///
+/// Joint angles, anatomical (see JointMapping.h), with phase p = 2 pi f t:
+/// \verbatim
+///   hip       left  A sin p                        right  -A sin p   (docs/SCENES.md: A = 0.5236 rad)
+///   knee      left  k0 + K max(0, cos p)^2         right  k0 + K max(0, -cos p)^2
+///             (the knee bends while its leg swings forward, most at mid-swing; C1-smooth)
+///   ankle     a (knee - hip): a = 1 keeps the foot level, a < 1 lets it follow the shin a little
+///   shoulder  left  -S sin p                       right  S sin p    (arms swing against the legs)
+///   elbow     left  E0 + E1 (1 - sin p) / 2        right  E0 + E1 (1 + sin p) / 2 (more bent when forward)
+///   shoulder roll  both  O + Os sin^2 p           (arms held a little away from the body, a little further
+///                                                  out at each end of their swing)
+/// \endverbatim
+/// then joint position = neutral + sign * angle, clamped to the joint's limits (see JointMapping.h: the
+/// neutral is 0, but the shoulder roll's, which hangs the arm down; when the neutral is 0 the position is
+/// exactly sign * angle). Every angle is a function of p alone, so the joint trajectories repeat every 1/f
+/// seconds (and the bob too when its frequency is a multiple of f). With f = 0 (standing) every angle is 0
+/// but the shoulder roll's O: the standing pose (standingAngles), the rest pose with the arms down.
 #pragma once
 
 #include "cape/character/Export.h"
@@ -35,6 +38,7 @@
 
 namespace cape::character {
 
+/// The gait's parameters: root motion and the amplitudes of the joint angle formulas above.
 struct CAPE_CHARACTER_API GaitParams {
   double speed = 0.0;            ///< m/s along the heading
   double turnRate = 0.0;         ///< rad/s about world +Y (positive turns to the character's left)
@@ -60,14 +64,16 @@ struct CAPE_CHARACTER_API GaitParams {
 
 /// The character frame at a time: world position on the ground (m), yaw about +Y (rad), bob (m).
 struct RootPose {
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  double yaw = 0.0;
-  double bob = 0.0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< m, world, on the ground
+  double yaw = 0.0;                                    ///< rad about +Y (0 faces -Z)
+  double bob = 0.0;                                    ///< m, the torso bob's height
   /// Where the URDF origin goes: position raised by the bob (for a scene motion, summed in float exactly as
   /// cape::BodyPose::frame() does, so the simple body and the URDF body share their frame to the last bit).
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
 };
 
+/// A procedural walking (or running) gait: root motion and anatomical joint angles as closed-form functions
+/// of time (see Gait.h).
 class CAPE_CHARACTER_API Gait {
  public:
   /// A gait of its own: root motion from speed and turn rate (exactly motionAt's straight line when the turn
@@ -78,10 +84,12 @@ class CAPE_CHARACTER_API Gait {
   /// Any scene motion description; amplitudes from GaitParams::forSpeed.
   static Gait fromMotion(const cape::MotionDesc& motion);
 
+  /// The gait's parameters.
   const GaitParams& params() const { return params_; }
   /// s after which the joint angles repeat (1 / stepFrequency); 0 when standing still.
   double period() const { return params_.stepFrequency > 0.0 ? 1.0 / params_.stepFrequency : 0.0; }
 
+  /// The character frame at time t (s).
   RootPose rootAt(double t) const;
   /// Anatomical angles of every role at time t (rad), indexed by GaitRole.
   std::array<double, kGaitRoleCount> anglesAt(double t) const;

@@ -1,8 +1,9 @@
-// Standing on the ground: the lowest point of a character's collision shapes, exactly per shape type, and
-// where its root must go for that point to touch the ground (world y = 0), with what was found on the way (a
-// floating base).
-//
-// Every height here is world y (Y up, docs/SCENES.md), in metres.
+/// \file
+/// Standing on the ground: the lowest point of a character's collision shapes, exactly per shape type, and
+/// where its root must go for that point to touch the ground (world y = 0), with what was found on the way (a
+/// floating base).
+///
+/// Every height here is world y (Y up, docs/SCENES.md), in metres.
 #pragma once
 
 #include "cape/character/Export.h"
@@ -18,12 +19,14 @@
 namespace cape::character {
 
 /// The lowest world y of a collision shape whose frame is at `pose` in the world (sizes as in the shape):
+/// \verbatim
 ///   sphere    centre - r
 ///   box       the lowest of its 8 corners
 ///   cylinder  the lowest rim point: centre - h |a_y| - r sqrt(1 - a_y^2), for its axis a (local z) and half
 ///             length h
 ///   capsule   the lower of its two sphere centres (centre +- h a) - r
 ///   hull      its lowest vertex - radius (its rounding); +infinity for a hull without vertices
+/// \endverbatim
 CAPE_CHARACTER_API double lowestPointY(const ShapeDesc& shape, const Eigen::Isometry3d& pose);
 
 /// The exact axis-aligned bounds of one collision shape placed at `pose` (m, in whatever frame pose is in):

@@ -1,32 +1,33 @@
-// Which joint of a URDF plays each role of the gait (left hip, right knee, ...), and which way it turns.
-//
-// The gait speaks in anatomical angles, the same for every model: a positive hip or shoulder angle swings the
-// limb forward, a positive knee angle bends the knee (shin backwards), a positive elbow angle bends the elbow
-// (forearm forwards), a positive ankle angle lifts the toes, a positive shoulder roll angle lifts the arm
-// sideways, away from the body. A URDF may turn its joints either way, so each role carries a sign, found
-// from the model itself: with the joint turned a little either side of rest, do the links beyond it move
-// forward or backward (URDF +x, seen in the root link's frame)? Hip, ankle, shoulder and elbow want
-// "forward", the knee "backward" (where the links are: their origins, shape centres and mesh hulls' centres).
-// A joint that moves its links neither way (its axis is not side to side) cannot be signed: byCommonNames
-// leaves it unmapped, and any mapping warns. A knee or an elbow that moves them neither way is signed by its
-// bend (positive brings the limb's end nearer the link above: a bent elbow, as H1's) or, failing that, by
-// limits that let it turn one way only (Atlas's elbows about x, which bend the hanging forearm out
-// sideways), which is said.
-//
-// Arms down. Each role also has a neutral joint position, where its anatomical angle is 0: 0 for every role
-// but the shoulder roll (abduction), whose neutral is the angle that brings the arm (the direction from the
-// roll joint to the farthest link origin or shape centre beyond it: the hand) as close as forward kinematics
-// allows to hanging straight down, from the rest pose. Its sign is the way that lifts the arm away from the
-// body there. So a model built in a T-pose or an A-pose walks with its arms at its sides. The other roles'
-// signs are found in that arms-down pose (in a T-pose the arm lies along the shoulder's pitch axis, and only
-// once it hangs down does a pitch joint swing it forward); a ball shoulder made of three revolute joints in
-// any order works the same way: whichever of them swings the hanging arm forward is the shoulder.
-//
-// Names, then structure. byCommonNames reads the joint names, also the robot abbreviations (Hubo's LHP,
-// Atlas's l_leg_hpy). byStructure reads only the kinematic tree and the rest pose: the legs are the two
-// branches that go down to the lowest links, the arms the two that reach farthest to either side; in each,
-// the joints that turn about the side-to-side axis, in order from the body. automatic takes the names, and
-// structure fills what they left empty, saying each such choice in warnings().
+/// \file
+/// Which joint of a URDF plays each role of the gait (left hip, right knee, ...), and which way it turns.
+///
+/// The gait speaks in anatomical angles, the same for every model: a positive hip or shoulder angle swings
+/// the limb forward, a positive knee angle bends the knee (shin backwards), a positive elbow angle bends the
+/// elbow (forearm forwards), a positive ankle angle lifts the toes, a positive shoulder roll angle lifts the
+/// arm sideways, away from the body. A URDF may turn its joints either way, so each role carries a sign,
+/// found from the model itself: with the joint turned a little either side of rest, do the links beyond it
+/// move forward or backward (URDF +x, seen in the root link's frame)? Hip, ankle, shoulder and elbow want
+/// "forward", the knee "backward" (where the links are: their origins, shape centres and mesh hulls'
+/// centres). A joint that moves its links neither way (its axis is not side to side) cannot be signed:
+/// byCommonNames leaves it unmapped, and any mapping warns. A knee or an elbow that moves them neither way is
+/// signed by its bend (positive brings the limb's end nearer the link above: a bent elbow, as H1's) or,
+/// failing that, by limits that let it turn one way only (Atlas's elbows about x, which bend the hanging
+/// forearm out sideways), which is said.
+///
+/// Arms down. Each role also has a neutral joint position, where its anatomical angle is 0: 0 for every role
+/// but the shoulder roll (abduction), whose neutral is the angle that brings the arm (the direction from the
+/// roll joint to the farthest link origin or shape centre beyond it: the hand) as close as forward kinematics
+/// allows to hanging straight down, from the rest pose. Its sign is the way that lifts the arm away from the
+/// body there. So a model built in a T-pose or an A-pose walks with its arms at its sides. The other roles'
+/// signs are found in that arms-down pose (in a T-pose the arm lies along the shoulder's pitch axis, and only
+/// once it hangs down does a pitch joint swing it forward); a ball shoulder made of three revolute joints in
+/// any order works the same way: whichever of them swings the hanging arm forward is the shoulder.
+///
+/// Names, then structure. byCommonNames reads the joint names, also the robot abbreviations (Hubo's LHP,
+/// Atlas's l_leg_hpy). byStructure reads only the kinematic tree and the rest pose: the legs are the two
+/// branches that go down to the lowest links, the arms the two that reach farthest to either side; in each,
+/// the joints that turn about the side-to-side axis, in order from the body. automatic takes the names, and
+/// structure fills what they left empty, saying each such choice in warnings().
 #pragma once
 
 #include "cape/character/Export.h"
@@ -38,25 +39,31 @@
 
 namespace cape::character {
 
+/// The roles a joint can play in the gait (anatomical angles as described above).
 enum class GaitRole : int {
-  LeftHip,
-  RightHip,
-  LeftKnee,
-  RightKnee,
-  LeftAnkle,
-  RightAnkle,
-  LeftShoulder,
-  RightShoulder,
-  LeftElbow,
-  RightElbow,
-  LeftShoulderRoll,  ///< shoulder abduction: the arm up and down sideways (optional: no warning if absent)
-  RightShoulderRoll,
+  LeftHip,            ///< swings the left leg forward
+  RightHip,           ///< swings the right leg forward
+  LeftKnee,           ///< bends the left knee
+  RightKnee,          ///< bends the right knee
+  LeftAnkle,          ///< lifts the left toes
+  RightAnkle,         ///< lifts the right toes
+  LeftShoulder,       ///< swings the left arm forward
+  RightShoulder,      ///< swings the right arm forward
+  LeftElbow,          ///< bends the left elbow
+  RightElbow,         ///< bends the right elbow
+  LeftShoulderRoll,   ///< shoulder abduction: the arm up and down sideways (optional: no warning if absent)
+  RightShoulderRoll,  ///< the same on the right
 };
+/// The number of roles (the size of per-role arrays).
 constexpr int kGaitRoleCount = 12;
+/// The role in words ("left hip", ...).
 CAPE_CHARACTER_API const char* toString(GaitRole role);
 
+/// Which joint of a URDF plays each GaitRole, which way it turns and where its arms-down neutral is (see
+/// JointMapping.h).
 class CAPE_CHARACTER_API JointMapping {
  public:
+  /// One role's joint.
   struct Entry {
     int joint = -1;     ///< index into UrdfModel::joints(); -1 = unmapped (that joint stays at rest)
     double sign = 1.0;  ///< joint position = neutral + sign * anatomical angle, clamped to the limits
@@ -104,7 +111,9 @@ class CAPE_CHARACTER_API JointMapping {
   /// finds them (a role mapped by name keeps its joint), each said in warnings().
   static JointMapping automatic(const UrdfModelPtr& model);
 
+  /// The role's entry.
   const Entry& operator[](GaitRole role) const { return entries_[static_cast<std::size_t>(role)]; }
+  /// Every role's entry, indexed by GaitRole.
   const std::array<Entry, kGaitRoleCount>& entries() const { return entries_; }
   /// Changes a role's neutral position (rad or m): Character puts the user's starting pose there.
   void setNeutral(GaitRole role, double q) { entries_[static_cast<std::size_t>(role)].neutral = q; }

@@ -1,21 +1,24 @@
-// Motion clips: sampled root poses and joint positions over time, played back on a character.
-//
-// A MotionClip is plain data, the same whatever file it came from (MotionFormats.h reads joint-trajectory
-// CSV, DeepMimic motion files and BVH motion capture into one). A MotionPlayer binds a clip to a skeleton's
-// joints once (unknown names are an error that lists the model's joints) and samples it at any time:
-//
-//   clip time  c = startTime + speed * t
-//   looping    c = k T + u, 0 <= u < T (T = duration()); the pose at u is carried by the k-th power of the
-//              loop's displacement D (the horizontal move and the turn about the up axis from the first
-//              sample to the last), so loop k starts exactly where loop k - 1 ended: no jump
-//   not looping c is held in [0, T] (the first or the last pose before and after)
-//   in place   the root's horizontal position stays at the first sample's (height and rotation kept)
-//   between samples  positions and joint values linearly, rotations by slerp (the shorter way)
-//
-// Frames. Clip root poses are the URDF root link's frame, in one of three frames (MotionFrame): the URDF's
-// (REP 103: z up, x forward; the character at yaw 0 faces +x), the character's Bullet world (Y-up or Z-up as
-// the character's settings say), or a Y-up tool's world (x forward, y up, z right: DeepMimic and PyBullet's
-// Y-up humanoid), turned onto z as the URDF loader turns a Y-up model. The player works in the URDF frame.
+/// \file
+/// Motion clips: sampled root poses and joint positions over time, played back on a character.
+///
+/// A MotionClip is plain data, the same whatever file it came from (MotionFormats.h reads joint-trajectory
+/// CSV, DeepMimic motion files and BVH motion capture into one). A MotionPlayer binds a clip to a skeleton's
+/// joints once (unknown names are an error that lists the model's joints) and samples it at any time:
+///
+/// \verbatim
+///   clip time  c = startTime + speed * t
+///   looping    c = k T + u, 0 <= u < T (T = duration()); the pose at u is carried by the k-th power of the
+///              loop's displacement D (the horizontal move and the turn about the up axis from the first
+///              sample to the last), so loop k starts exactly where loop k - 1 ended: no jump
+///   not looping c is held in [0, T] (the first or the last pose before and after)
+///   in place   the root's horizontal position stays at the first sample's (height and rotation kept)
+///   between samples  positions and joint values linearly, rotations by slerp (the shorter way)
+/// \endverbatim
+///
+/// Frames. Clip root poses are the URDF root link's frame, in one of three frames (MotionFrame): the URDF's
+/// (REP 103: z up, x forward; the character at yaw 0 faces +x), the character's Bullet world (Y-up or Z-up as
+/// the character's settings say), or a Y-up tool's world (x forward, y up, z right: DeepMimic and PyBullet's
+/// Y-up humanoid), turned onto z as the URDF loader turns a Y-up model. The player works in the URDF frame.
 #pragma once
 
 #include "cape/character/Export.h"
@@ -29,12 +32,14 @@
 
 namespace cape::character {
 
+/// The frame a clip's root poses are given in (see Motion.h).
 enum class MotionFrame : int {
   Urdf,   ///< z up, x forward, y left (REP 103): the URDF's own axes
   World,  ///< the character's Bullet world: Y-up (the character at yaw 0 faces -Z) or Z-up (faces +X)
   YUp,    ///< x forward, y up, z right (DeepMimic); for a model turned onto z (UrdfModel::turnedOntoZ) the
           ///< root rotation is taken as the file's, before the turn
 };
+/// "urdf", "world" or "y-up".
 CAPE_CHARACTER_API const char* toString(MotionFrame frame);
 
 /// Samples of a motion: times, the root link's pose and named joints' positions at each.
@@ -50,6 +55,7 @@ struct CAPE_CHARACTER_API MotionClip {
   std::vector<Eigen::Quaterniond> rotations;      ///< unit, sample-major: rotations[s * balls + b]
   bool loop = true;                               ///< what the file says (DeepMimic "Loop")
 
+  /// The number of samples.
   int sampleCount() const { return static_cast<int>(times.size()); }
   /// s: times.back() - times.front() (0 for fewer than two samples).
   double duration() const { return times.size() < 2 ? 0.0 : times.back() - times.front(); }
@@ -61,12 +67,14 @@ struct CAPE_CHARACTER_API MotionClip {
 
 /// A loader's answer: ok and a clip, or an error naming the file, the line (or frame) and the problem.
 struct MotionClipResult {
-  Status status;
-  MotionClip clip;
-  std::vector<std::string> warnings;
+  Status status;                      ///< Why there is no clip, or success
+  MotionClip clip;                    ///< The clip (empty on error)
+  std::vector<std::string> warnings;  ///< What the loader said on the way (guesses, frames left out, ...)
+  /// True when a clip was read.
   bool ok() const { return status.ok(); }
 };
 
+/// How a MotionPlayer plays a clip: speed, start, looping, root motion, and where it starts.
 struct PlaybackSettings {
   double speed = 1.0;      ///< clip seconds per second, finite and > 0
   double startTime = 0.0;  ///< s of clip time at t = 0, finite (negative starts before the first sample)
@@ -84,11 +92,12 @@ struct PlaybackSettings {
 /// One sampled pose, bound to a skeleton: the root link's pose in the URDF frame and the bound joints'
 /// positions, in the player's binding order (MotionPlayer::jointIndices(), ballIndices()).
 struct MotionPose {
-  Eigen::Isometry3d root = Eigen::Isometry3d::Identity();
-  std::vector<double> values;
-  std::vector<Eigen::Quaterniond> rotations;
+  Eigen::Isometry3d root = Eigen::Isometry3d::Identity();  ///< The root link's pose, URDF frame, m
+  std::vector<double> values;                              ///< rad or m, per bound scalar joint
+  std::vector<Eigen::Quaterniond> rotations;               ///< unit, per bound ball joint
 };
 
+/// A clip bound to a skeleton's joints, sampled at any time (see Motion.h for looping and frames).
 class CAPE_CHARACTER_API MotionPlayer {
  public:
   /// Binds `clip` to `skeleton`'s model: every scalar joint must be a movable joint of it and every ball a
@@ -97,18 +106,22 @@ class CAPE_CHARACTER_API MotionPlayer {
   /// the skeleton's up axis. Joint values outside the limits are clamped when applied.
   static Status create(const MotionClip& clip, const Skeleton& skeleton, const PlaybackSettings& settings,
                        MotionPlayer& out);
-  MotionPlayer() = default;
+  MotionPlayer() = default;  ///< Unbound: create() binds it.
 
   /// The pose at time t (s; any finite t). `out` is reused: no allocation once it has grown.
   void sample(double t, MotionPose& out) const;
   /// Clip time (s, in [0, duration]) and loop count at time t.
   double clipTime(double t, long long* loops = nullptr) const;
 
+  /// The bound clip, in the URDF frame, its first sample at time 0.
   const MotionClip& clip() const { return clip_; }
+  /// How it plays.
   const PlaybackSettings& settings() const { return settings_; }
+  /// s: the clip's duration.
   double duration() const { return clip_.duration(); }
   /// Skeleton joint index of each of the clip's scalar joints and balls.
   const std::vector<int>& jointIndices() const { return jointIndex_; }
+  /// Skeleton joint index of each of the clip's ball joints.
   const std::vector<int>& ballIndices() const { return ballIndex_; }
   /// The model it was bound to (kept alive by the player).
   const UrdfModelPtr& model() const { return model_; }
@@ -141,9 +154,10 @@ CAPE_CHARACTER_API double headingAboutZ(const Eigen::Quaterniond& q);
 /// joint's name or "root"). A cycle (a walk or a run cut at the same phase) has a small gap; a clip that is
 /// not one jumps every loop. 0 and "" for fewer than two samples.
 struct LoopGap {
-  double value = 0.0;
-  std::string where;
+  double value = 0.0;  ///< rad or m: the largest jump
+  std::string where;   ///< the joint's name, or "root"
 };
+/// The clip's loop gap (see LoopGap).
 CAPE_CHARACTER_API LoopGap loopGap(const MotionClip& clip);
 
 }  // namespace cape::character

@@ -1,10 +1,11 @@
-// A URDF robot description loaded with urdfdom into plain data: links with their collision shapes, joints
-// with their origins, axes and limits, in a parents-before-children order. Everything here is in the URDF's
-// own frame and units (REP 103: metres, radians, Z up, X forward); Skeleton maps it into the Y-up world.
-//
-// Loading never throws and never crashes on bad data: it returns a Status (see Status.h) naming the problem.
-// urdfdom prints its diagnostics through console_bridge; while we parse they are captured instead and folded
-// into our error message or, for a model that loads, into warnings().
+/// \file
+/// A URDF robot description loaded with urdfdom into plain data: links with their collision shapes, joints
+/// with their origins, axes and limits, in a parents-before-children order. Everything here is in the URDF's
+/// own frame and units (REP 103: metres, radians, Z up, X forward); Skeleton maps it into the Y-up world.
+///
+/// Loading never throws and never crashes on bad data: it returns a Status (see Status.h) naming the problem.
+/// urdfdom prints its diagnostics through console_bridge; while we parse they are captured instead and folded
+/// into our error message or, for a model that loads, into warnings().
 #pragma once
 
 #include "cape/character/Export.h"
@@ -23,12 +24,19 @@ namespace cape::character {
 /// Collision shapes. Capsule is the `<capsule radius length>` extension that Bullet's URDF importer,
 /// PyBullet, Drake and the MuJoCo converters write (urdfdom itself has none). A mesh element becomes a
 /// ConvexHull: the convex hull of the mesh file's vertices, simplified to a vertex budget (UrdfLoadOptions).
-enum class ShapeType : int { Sphere, Box, Cylinder, Capsule, ConvexHull };
+enum class ShapeType : int {
+  Sphere,      ///< `radius`
+  Box,         ///< `halfExtents`
+  Cylinder,    ///< `radius` and `halfLength`, along local z
+  Capsule,     ///< `radius` around a segment of `halfLength` along local z
+  ConvexHull,  ///< `hull` and `hullPlanes`, grown by `radius`
+};
+/// The type's name ("sphere", "box", ...).
 CAPE_CHARACTER_API const char* toString(ShapeType type);
 
 /// One collision element of a link, in the link's frame.
 struct ShapeDesc {
-  ShapeType type = ShapeType::Sphere;
+  ShapeType type = ShapeType::Sphere;  ///< Which of the size fields below apply
   double radius = 0.0;      ///< m; sphere, cylinder and capsule; for a hull, its rounding (see hull)
   double halfLength = 0.0;  ///< m; cylinder, and a capsule's cylindrical part, along its local z (URDF rule)
   Eigen::Vector3d halfExtents = Eigen::Vector3d::Zero();  ///< m; box, along its local x, y, z
@@ -39,45 +47,58 @@ struct ShapeDesc {
   std::vector<Eigen::Vector4d> hullPlanes;
   std::string meshFile;  ///< ConvexHull: the mesh file it was made from, as resolved on disk
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< shape frame in the link frame
-  std::string name;  ///< the element's name attribute, or "<link>#<k>" when it has none
+  std::string name;  ///< the element's name attribute, or `<link>#<k>` when it has none
 };
 
 /// Spherical is Bullet's importer's extension (`type="spherical"`, a ball joint: PyBullet's DeepMimic
 /// humanoid has eight); urdfdom has none, so it is read as floating and marked spherical here. Its position
 /// is a rotation (Skeleton::setJointRotation), not a number.
-enum class JointType : int { Fixed, Revolute, Continuous, Prismatic, Floating, Planar, Spherical };
+enum class JointType : int {
+  Fixed,       ///< does not move
+  Revolute,    ///< turns about `axis` within its limits, rad
+  Continuous,  ///< turns about `axis` without limits, rad
+  Prismatic,   ///< slides along `axis` within its limits, m
+  Floating,    ///< six degrees of freedom (not driven here)
+  Planar,      ///< moves in the plane normal to `axis` (not driven here)
+  Spherical,   ///< a ball joint: a rotation (Skeleton::setJointRotation)
+};
+/// The type's name ("fixed", "revolute", ...).
 CAPE_CHARACTER_API const char* toString(JointType type);
 
+/// One link of the model.
 struct LinkDesc {
-  std::string name;
-  int parentJoint = -1;  ///< index into UrdfModel::joints(); -1 for the root
-  int parentLink = -1;   ///< index into UrdfModel::links(); -1 for the root
-  std::vector<int> childJoints;
+  std::string name;               ///< The link's name in the URDF
+  int parentJoint = -1;           ///< index into UrdfModel::joints(); -1 for the root
+  int parentLink = -1;            ///< index into UrdfModel::links(); -1 for the root
+  std::vector<int> childJoints;   ///< indices into UrdfModel::joints() of the joints below it
   std::vector<ShapeDesc> shapes;  ///< collision elements that could be used (the others: warnings())
-  double mass = 0.0;              ///< kg, from <inertial>; 0 when absent
+  double mass = 0.0;              ///< kg, from `<inertial>`; 0 when absent
 };
 
+/// One joint of the model.
 struct JointDesc {
-  std::string name;
-  JointType type = JointType::Fixed;
-  int parentLink = -1;
-  int childLink = -1;
+  std::string name;                                          ///< The joint's name in the URDF
+  JointType type = JointType::Fixed;                         ///< How it moves
+  int parentLink = -1;                                       ///< index into UrdfModel::links()
+  int childLink = -1;                                        ///< index into UrdfModel::links()
   Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();  ///< child joint frame in the parent link frame
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();           ///< unit vector in the joint frame
-  bool hasLimits = false;  ///< revolute and prismatic always; continuous never (position is unbounded)
-  double lower = 0.0;      ///< rad (revolute) or m (prismatic)
-  double upper = 0.0;
-  double maxVelocity = 0.0;  ///< rad/s or m/s, as written in <limit velocity=...>; 0 when absent
+  bool hasLimits = false;    ///< revolute and prismatic always; continuous never (position is unbounded)
+  double lower = 0.0;        ///< rad (revolute) or m (prismatic)
+  double upper = 0.0;        ///< rad (revolute) or m (prismatic)
+  double maxVelocity = 0.0;  ///< rad/s or m/s, as written in `<limit velocity=...>`; 0 when absent
 
   /// One scalar position (revolute, continuous, prismatic); fixed, floating, planar and spherical joints have
   /// none (a spherical joint's position is a rotation: isSpherical).
   bool isSpherical() const { return type == JointType::Spherical; }
+  /// True for a joint with one scalar position: revolute, continuous or prismatic.
   bool isMovable() const {
     return type == JointType::Revolute || type == JointType::Continuous || type == JointType::Prismatic;
   }
 };
 
 class UrdfModel;
+/// A shared, immutable model.
 using UrdfModelPtr = std::shared_ptr<const UrdfModel>;
 
 /// The most a URDF may hold. A model over a limit is refused before the expensive part of the load, with an
@@ -95,11 +116,11 @@ struct UrdfLimits {
   /// Nesting depth of the XML elements (a URDF is 5 deep). MalformedXml. At most 1024: urdfdom's parser
   /// recurses once per level (tens of thousands of levels overflow its stack).
   std::size_t maxXmlDepth = 256;
-  /// <link> elements of the <robot>. InvalidModel. Each link becomes one rigid body.
+  /// `<link>` elements of the `<robot>`. InvalidModel. Each link becomes one rigid body.
   std::size_t maxLinks = 10000;
-  /// <joint> elements of the <robot>. InvalidModel. A tree of n links has n - 1 joints.
+  /// `<joint>` elements of the `<robot>`. InvalidModel. A tree of n links has n - 1 joints.
   std::size_t maxJoints = 10000;
-  /// <collision> elements of all links together. InvalidModel.
+  /// `<collision>` elements of all links together. InvalidModel.
   std::size_t maxCollisionElements = 100000;
   /// Triangles of all mesh collision elements of the model together: each element counts every triangle of
   /// its file (every node instance), also when another element uses the same file. InvalidModel. A detailed
@@ -129,8 +150,12 @@ struct UrdfLoadOptions {
   /// x of everything below the root link). Auto: z, unless the model in its zero pose is more than twice as
   /// long along y as along z and, turned, has legs whose joints the mapping finds by structure (an upper body
   /// in a T-pose is long along y too, but has no legs either way); either case is said in a warning.
-  enum class Up : int { Auto, Z, Y };
-  Up modelUp = Up::Auto;
+  enum class Up : int {
+    Auto,  ///< Z, unless the model looks Y-up as described above.
+    Z,     ///< The file is Z-up (REP 103).
+    Y,     ///< The file is Y-up: turned onto z.
+  };
+  Up modelUp = Up::Auto;  ///< The axis the model stands along in its file.
   /// The most a model may hold (file size, XML depth and elements, links, joints, collision elements, mesh
   /// triangles).
   UrdfLimits limits;
@@ -139,33 +164,39 @@ struct UrdfLoadOptions {
 /// What a load returns: ok and a model, or an error status and no model. `warnings` holds what was said on
 /// the way, in order, also when the load failed (so the cause of a failure is not hidden).
 struct UrdfLoadResult {
-  Status status;
-  UrdfModelPtr model;
-  std::vector<std::string> warnings;
+  Status status;                      ///< Why there is no model, or success
+  UrdfModelPtr model;                 ///< The model; null on error
+  std::vector<std::string> warnings;  ///< What was said on the way, in order
+  /// True when a model was loaded.
   bool ok() const { return status.ok() && model != nullptr; }
 };
 
 /// Shared and immutable once loaded: any number of Skeletons may use one model.
+/// A URDF robot description as plain data (see Urdf.h).
 class CAPE_CHARACTER_API UrdfModel {
  public:
   /// Reads and parses a URDF file. FileNotFound when the path is not a readable regular file; InvalidModel,
   /// before anything is read, when it is larger than options.limits.maxFileBytes.
   static UrdfLoadResult fromFile(const std::string& path, const UrdfLoadOptions& options = {});
   /// Parses URDF text. The text ends at its first NUL byte, as for Bullet's importer (PyBullet's humanoid
-  /// ships with one after </robot>).
+  /// ships with one after `</robot>`).
   static UrdfLoadResult fromString(const std::string& xml, const UrdfLoadOptions& options = {});
   /// The humanoid shipped in character/models/humanoid.urdf, compiled into the library (no file needed).
   static UrdfLoadResult humanoid();
   /// The text of that humanoid.
   static const std::string& humanoidUrdf();
 
+  /// The `<robot>`'s name.
   const std::string& name() const { return name_; }
   /// Links in parents-before-children order; links()[rootLink()] is the root (index 0).
   const std::vector<LinkDesc>& links() const { return links_; }
+  /// Joints in the order of their child links.
   const std::vector<JointDesc>& joints() const { return joints_; }
+  /// The root link's index: 0.
   int rootLink() const { return 0; }
   /// Index of the link or joint of that name, -1 if none.
   int findLink(const std::string& name) const;
+  /// Index of the joint of that name, -1 if none.
   int findJoint(const std::string& name) const;
   /// Names of the links whose name contains `part` (case-insensitive), in link order: "shoulder" finds the
   /// shipped humanoid's left_shoulder and right_shoulder.

@@ -1,9 +1,10 @@
-// The btSoftBody twin of a cape: Bullet's own soft body on the same grid (nodes where the cape's particles
-// are now, the same masses), with a link for every spring of the chosen families, anchored to the same
-// bodies at the same body-local pivots, colliding with the same rigid bodies; and its twin in Bullet's
-// deformable world. The comparison's own tools (library cape::compare_twins, used by cape_compare and its
-// tests), not part of the Bullet adapter. Anchored bodies should be kinematic: btSoftBody anchors pull on
-// dynamic bodies, the cape's pins do not.
+/// \file
+/// The btSoftBody twin of a cape: Bullet's own soft body on the same grid (nodes where the cape's particles
+/// are now, the same masses), with a link for every spring of the chosen families, anchored to the same
+/// bodies at the same body-local pivots, colliding with the same rigid bodies; and its twin in Bullet's
+/// deformable world. The comparison's own tools (library cape::compare_twins, used by cape_compare and its
+/// tests), not part of the Bullet adapter. Anchored bodies should be kinematic: btSoftBody anchors pull on
+/// dynamic bodies, the cape's pins do not.
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
@@ -21,6 +22,8 @@
 /// cape, for cape_compare and its tests.
 namespace cape::compare {
 
+/// How makeSoftBodyTwin builds the btSoftBody twin: which links, and Bullet's soft body parameters (Bullet's
+/// own names given; its coefficients are dimensionless).
 struct SoftBodyTwinSettings {
   bool structuralLinks = true;  ///< Rows and columns.
   bool shearLinks = true;       ///< Both diagonals of every cell.
@@ -40,7 +43,7 @@ struct SoftBodyTwinSettings {
   int collisions = btSoftBody::fCollision::SDF_RS;
   /// Collision filter of the soft body in the world (the cape's, by default).
   int collisionGroup = btBroadphaseProxy::DefaultFilter;
-  int collisionMask = btBroadphaseProxy::AllFilter;
+  int collisionMask = btBroadphaseProxy::AllFilter;  ///< The groups it collides with (bit mask).
 };
 
 /// Builds the twin of `cape` from its current state and attachments, adds it to `world` and returns it.
@@ -64,25 +67,28 @@ struct DeformableTwinSettings {
   /// The default is about the stiffest the deformable world keeps finite with the canonical cape's light
   /// nodes at 1/240 s, far softer than the cape's own structural springs (docs/COMPARISON.md, "Method").
   btScalar elasticStiffness = btScalar(50);
-  btScalar dampingStiffness = btScalar(0.1);
-  btScalar friction = btScalar(0.3);  ///< m_cfg.kDF.
-  btScalar margin = btScalar(0.01);   ///< Collision margin, m.
+  btScalar dampingStiffness = btScalar(0.1);  ///< N s/m, damping along the links (see elasticStiffness).
+  btScalar friction = btScalar(0.3);          ///< m_cfg.kDF.
+  btScalar margin = btScalar(0.01);           ///< Collision margin, m.
   /// m_cfg.collisions: the deformable world's contacts against rigid bodies, nodes and faces.
   int collisions = btSoftBody::fCollision::SDF_RD | btSoftBody::fCollision::SDF_RDF;
-  int collisionGroup = btBroadphaseProxy::DefaultFilter;
-  int collisionMask = btBroadphaseProxy::AllFilter;
+  int collisionGroup = btBroadphaseProxy::DefaultFilter;  ///< Its collision filter group (bit mask).
+  int collisionMask = btBroadphaseProxy::AllFilter;       ///< The groups it collides with (bit mask).
 };
 
 /// A deformable twin in its world; removes itself (body and forces) when destroyed, so it must not outlive
 /// the world.
 class CAPE_COMPARE_API DeformableTwin {
  public:
+  /// Takes the body and its forces, already added to `world`, and owns them.
   DeformableTwin(btDeformableMultiBodyDynamicsWorld& world, std::unique_ptr<btSoftBody> body,
                  std::vector<std::unique_ptr<btDeformableLagrangianForce>> forces);
   ~DeformableTwin();
   DeformableTwin(const DeformableTwin&) = delete;
   DeformableTwin& operator=(const DeformableTwin&) = delete;
+  /// The soft body (its nodes are the cape's particles, in order).
   btSoftBody& body() { return *body_; }
+  /// The soft body (its nodes are the cape's particles, in order).
   const btSoftBody& body() const { return *body_; }
 
  private:

@@ -1,5 +1,6 @@
-// The quality metrics of docs/SCENES.md as library code, so that tests, demos, benchmarks and
-// comparisons measure exactly the same thing.
+/// \file
+/// The quality metrics of docs/SCENES.md as library code, so that tests, demos, benchmarks and
+/// comparisons measure exactly the same thing.
 #pragma once
 
 #include "cape/core/Cape.h"
@@ -46,6 +47,7 @@ CAPE_SCENES_API bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Ve
 /// between calls (one counter per cape: no allocation once it has seen the cape's size).
 class CAPE_SCENES_API SelfIntersectionCounter {
  public:
+  /// The number of intersecting pairs of the fabric's triangles at `positions` (m, one row per particle).
   int count(const Fabric& fabric, const Points& positions);
 
  private:
@@ -77,16 +79,16 @@ class CAPE_SCENES_API SelfIntersectionCounter {
 
 /// Per-frame values and run summary of every metric, as the demos report them.
 struct FrameMetrics {
-  float maxStrain = 0.0f;
-  float meanStrain = 0.0f;
-  float maxPenetration = 0.0f;
-  int selfIntersections = 0;
-  float pinError = 0.0f;
-  float meanSpeed = 0.0f;  ///< m/s, over particles
+  float maxStrain = 0.0f;       ///< The largest structural strain (StrainStats::max), dimensionless
+  float meanStrain = 0.0f;      ///< The mean structural strain (StrainStats::mean), dimensionless
+  float maxPenetration = 0.0f;  ///< m, maxPenetration() over the body colliders
+  int selfIntersections = 0;    ///< Intersecting triangle pairs (0 when not counted)
+  float pinError = 0.0f;        ///< m, maxPinError()
+  float meanSpeed = 0.0f;       ///< m/s, over particles
   /// Particles the cape's numerical guard restored in the frame's steps (Cape::guard(): not finite, or run
   /// away from the pins). The guard keeps the NaN from lasting; the frame counts as blown up all the same.
   std::uint32_t guardRestored = 0;
-  bool blowUp = false;
+  bool blowUp = false;  ///< A coordinate not finite, or a particle beyond isBlownUp()'s radius
 };
 
 /// Measures a frame of any solver's cloth on `fabric` (ours, or a Bullet twin copied into these arrays), so
@@ -108,22 +110,23 @@ CAPE_SCENES_API FrameMetrics measureFrame(const Cape& cape, ColliderSpan bodyCol
 /// blown up if either is): a crowd's row holds the worst of its characters.
 CAPE_SCENES_API FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b);
 
+/// The summary of a run, frame by frame metrics accumulated by MetricsRecorder.
 struct RunSummary {
-  std::int64_t frames = 0;
+  std::int64_t frames = 0;  ///< Frames measured
   float maxStrain = 0.0f;   ///< max over frames of the per-frame max strain (signed)
   double meanStrain = 0.0;  ///< mean over frames of the per-frame mean strain
   float medianFrameMaxStrain =
       0.0f;                        ///< median over frames of the per-frame max strain (PercentileEstimator)
   float p95FrameMaxStrain = 0.0f;  ///< 95th percentile over frames of the per-frame max strain (the same)
-  float maxPenetration = 0.0f;
-  std::int64_t framesPenetrationOver1mm = 0;
-  int selfIntersectionsMax = 0;
-  std::int64_t framesWithSelfIntersections = 0;
-  float pinErrorMax = 0.0f;
-  std::int64_t guardRestored = 0;        ///< particles the numerical guard restored, over the run
-  std::int64_t framesGuardRestored = 0;  ///< frames in which it restored any
-  bool blowUp = false;
-  float restJitter = 0.0f;  ///< mean particle speed over the last second, m/s
+  float maxPenetration = 0.0f;     ///< m, the largest over frames
+  std::int64_t framesPenetrationOver1mm = 0;     ///< Frames whose penetration exceeds 1 mm
+  int selfIntersectionsMax = 0;                  ///< The most intersecting triangle pairs in a frame
+  std::int64_t framesWithSelfIntersections = 0;  ///< Frames with at least one
+  float pinErrorMax = 0.0f;                      ///< m, the largest over frames
+  std::int64_t guardRestored = 0;                ///< particles the numerical guard restored, over the run
+  std::int64_t framesGuardRestored = 0;          ///< frames in which it restored any
+  bool blowUp = false;                           ///< Any frame blew up
+  float restJitter = 0.0f;                       ///< mean particle speed over the last second, m/s
 };
 
 /// Nearest-rank percentiles of a stream of values in bounded memory (about 110 KB, allocated up front,
@@ -137,15 +140,18 @@ struct RunSummary {
 /// exact). NaN values are not counted.
 class CAPE_SCENES_API PercentileEstimator {
  public:
-  static constexpr std::size_t kExactValues = 4096;
-  static constexpr double kRelativeError = 0.005;
-  static constexpr double kSmallest = 1e-9;
-  static constexpr double kLargest = 1e12;
+  static constexpr std::size_t kExactValues = 4096;  ///< Values kept exactly before the histogram takes over
+  static constexpr double kRelativeError = 0.005;    ///< a: the histogram's relative error bound
+  static constexpr double kSmallest = 1e-9;          ///< s: magnitudes below it count as 0
+  static constexpr double kLargest = 1e12;           ///< Magnitudes above it share the last bucket
 
+  /// No values yet; all the memory allocated.
   PercentileEstimator();
+  /// Counts a value (NaN is ignored).
   void add(double value);
   /// The p-th percentile (nearest rank), p in [0, 100]; 0 when no value came.
   double percentile(double p) const;
+  /// The number of values counted.
   std::int64_t count() const { return count_; }
   /// True while every value is kept (the percentiles are exact).
   bool exact() const { return count_ <= static_cast<std::int64_t>(kExactValues); }
@@ -164,8 +170,11 @@ class CAPE_SCENES_API PercentileEstimator {
 /// strain in a PercentileEstimator, and the mean speeds of the last second.
 class CAPE_SCENES_API MetricsRecorder {
  public:
+  /// A recorder for frames `frameTime` s apart (sizes the last second's ring).
   explicit MetricsRecorder(double frameTime = 1.0 / 60.0);
+  /// Adds one frame.
   void add(const FrameMetrics& m);
+  /// The summary of every frame added so far.
   RunSummary summary() const;
 
  private:

@@ -1,5 +1,6 @@
-// The canonical scenes of docs/SCENES.md on the simple body, with no Bullet: tests, benchmarks and the
-// demos' --simple-body mode drive the solver exactly alike.
+/// \file
+/// The canonical scenes of docs/SCENES.md on the simple body, with no Bullet: tests, benchmarks and the
+/// demos' --simple-body mode drive the solver exactly alike.
 #pragma once
 
 #include "cape/core/Cape.h"
@@ -10,13 +11,25 @@
 
 namespace cape {
 
-enum class SceneKind : int { Hang, Walk, SprintTurn, Wind, Crowd };
+/// The canonical scenes of docs/SCENES.md.
+enum class SceneKind : int {
+  Hang,        ///< The cape falls from horizontal and hangs from a still body.
+  Walk,        ///< Walking at 1.4 m/s.
+  SprintTurn,  ///< Sprinting at 5 m/s with a 180 degree turn every 2 s.
+  Wind,        ///< A still body in gusty wind.
+  Crowd,       ///< Many walking characters side by side.
+};
+/// The scene's name: "hang", "walk", "sprint-turn", "wind" or "crowd" ("?" outside the enum).
 CAPE_SCENES_API const char* toString(SceneKind kind);
 /// Parses "hang", "walk", "sprint-turn", "wind", "crowd"; false if unknown.
 CAPE_SCENES_API bool parseSceneKind(const std::string& name, SceneKind& kind);
 
 /// Which cape particles are pinned (docs/SCENES.md's attachment): the two top corners, or the whole top row.
-enum class PinLayout : int { Corners, Collar };
+enum class PinLayout : int {
+  Corners,  ///< The two top corners.
+  Collar,   ///< Every particle of the top row.
+};
+/// The layout's name: "corners" or "collar".
 CAPE_SCENES_API const char* toString(PinLayout layout);
 /// Parses "corners", "collar"; false if unknown.
 CAPE_SCENES_API bool parsePinLayout(const std::string& name, PinLayout& layout);
@@ -29,10 +42,11 @@ struct CAPE_SCENES_API MotionDesc {
   float bobAmplitude = 0.0f;     ///< m, half the peak-to-peak torso bob
   float bobFrequency = 0.0f;     ///< Hz
   bool turns = false;            ///< sprint-turn: 180 degrees in the last turnDuration of every turnPeriod
-  float turnPeriod = 2.0f;
-  float turnDuration = 0.5f;
-  float duration = 10.0f;  ///< s, the scene's length
+  float turnPeriod = 2.0f;       ///< s between the starts of two turns
+  float turnDuration = 0.5f;     ///< s each turn takes
+  float duration = 10.0f;        ///< s, the scene's length
 
+  /// The motion of a canonical scene (docs/SCENES.md).
   static MotionDesc forScene(SceneKind kind);
 };
 
@@ -45,11 +59,11 @@ CAPE_SCENES_API CapeSettings settingsForScene(SceneKind kind, CapeSettings setti
 /// The character's pose at a time: its frame (origin on the ground between the feet, facing -Z when yaw = 0),
 /// the torso bob and the left leg angle (the right leg is its negative).
 struct CAPE_SCENES_API BodyPose {
-  Vec3 position = Vec3::Zero();
-  float yaw = 0.0f;  ///< rad about +Y
-  float bob = 0.0f;  ///< m, added to every body part's height
-  float legAngle = 0.0f;
-  Pose frame() const;  ///< The character frame in the world, bob included.
+  Vec3 position = Vec3::Zero();  ///< m, world: the frame's origin on the ground
+  float yaw = 0.0f;              ///< rad about +Y
+  float bob = 0.0f;              ///< m, added to every body part's height
+  float legAngle = 0.0f;         ///< rad, the left leg's swing forward (the right leg's is its negative)
+  Pose frame() const;            ///< The character frame in the world, bob included.
 };
 
 /// Exact pose at time t (closed form, independent of the step size).
@@ -59,11 +73,16 @@ CAPE_SCENES_API BodyPose motionAt(const MotionDesc& motion, double t);
 /// Collider order: torso, left shoulder, right shoulder, left leg, right leg, ground.
 class CAPE_SCENES_API SimpleBody {
  public:
+  /// Collider indices: torso box, shoulder spheres, leg capsules, and the ground plane last.
+  ///@{
   static constexpr int kTorso = 0, kLeftShoulder = 1, kRightShoulder = 2, kLeftLeg = 3, kRightLeg = 4,
                        kGround = 5;
+  ///@}
+  /// The body standing at `offset` (m, world) in the rest pose (BodyPose()), every collider at rest.
   explicit SimpleBody(const Vec3& offset = Vec3::Zero());
   /// Body colliders only (not the ground), for the penetration metric.
   ColliderSpan bodyColliders() const { return ColliderSpan(colliders_.data(), colliders_.size() - 1); }
+  /// Every collider, the ground included, in the order of the indices above.
   const std::vector<Collider>& colliders() const { return colliders_; }
   /// Moves every body collider to the pose (sweeping from where it was); teleport = no sweep.
   void moveTo(const BodyPose& pose, bool teleport = false);
@@ -78,14 +97,14 @@ class CAPE_SCENES_API SimpleBody {
 /// Character-frame attachment points: "corners" pins the top corners at (+-0.30, 1.56, 0.15); "collar" pins
 /// the whole top row along the same line.
 struct CapeRig {
-  FabricPtr fabric;
+  FabricPtr fabric;                            ///< The cape's fabric, with tethers to the pinned particles
   std::vector<std::uint32_t> pinnedParticles;  ///< Fabric particle indices
   std::vector<Vec3> pinLocalPoints;            ///< in the character frame, m
 };
 /// A cape's size, m: the canonical 0.6 x 1.0 (docs/SCENES.md), or one fitted to a character.
 struct CapeSize {
-  float width = 0.6f;
-  float height = 1.0f;
+  float width = 0.6f;   ///< m, along the top row
+  float height = 1.0f;  ///< m, from the top row down
 };
 /// The N x N cape (the canonical 0.6 m x 1.0 m, 0.4 kg; another size keeps its mass per area) with tethers
 /// to its attachment particles, its top row centred on the canonical pin line.
@@ -98,18 +117,27 @@ CAPE_SCENES_API Pose capeStartPlacement(SceneKind kind, const CapeSize& size = C
 /// One cape on the simple body, stepped frame by frame: what tests and benchmarks run.
 class CAPE_SCENES_API SimpleScene {
  public:
+  /// The scene's N x N cape (makeCapeRig) on the simple body standing at `offset` (m, world), with the
+  /// scene's settings (settingsForScene) at t = 0. Check status().
   SimpleScene(SceneKind kind, int n, PinLayout layout, const CapeSettings& settings,
               const Vec3& offset = Vec3::Zero());
+  /// The cape's status (an error for bad settings).
   const Status& status() const { return cape_.status(); }
   /// Advances one frame of dt seconds: moves the body and the pins, then steps the cape.
   void advanceFrame(float dt = 1.0f / 60.0f);
+  /// s simulated so far.
   double time() const { return time_; }
   /// The scene it was made for (its motion and the cape's settings follow from it).
   SceneKind kind() const { return kind_; }
+  /// The body's motion (MotionDesc::forScene).
   const MotionDesc& motion() const { return motion_; }
+  /// The cape.
   Cape& cape() { return cape_; }
+  /// The cape.
   const Cape& cape() const { return cape_; }
+  /// The simple body and its colliders.
   const SimpleBody& body() const { return body_; }
+  /// The cape's fabric and pins.
   const CapeRig& rig() const { return rig_; }
 
  private:

@@ -1,27 +1,28 @@
-// CapeAction: one cape stepping with a Bullet world. `world->addAction(&action)` is all it takes: Bullet
-// calls updateAction() once per internal fixed step, after the rigid bodies have moved, and the action
-// converts what it needs (pin targets from the bodies it is attached to, colliders from the bodies it
-// touches) and delegates the step to cape::Cape.
-//
-// Discovery goes through the world's broadphase (btBroadphaseInterface::aabbTest over the cape's grown
-// bounds; btDbvtBroadphase answers from its AABB trees), so its cost follows the objects near the cape, not
-// the size of the world. What it finds is ordered by the objects' indices in the world's collision object
-// array (read while Bullet reports them, so while they are certainly in the world), never by the
-// broadphase's tree order or by addresses: the followed objects, and so the colliders, keep the order of
-// first sight, ties in one step broken by array index.
-//
-// Ownership (Bullet's rule): the user owns the bodies, removes them from the world before deleting them,
-// and removes the action from the world before destroying it. The action never dereferences a body that
-// is no longer in the world. It remembers, for every object it follows (attachment bodies and colliders),
-// the index in the world's collision object array where it last saw it; at the start of every update it
-// checks `index < size && array[index] == pointer` for each (pointers only). If every check holds, nothing
-// left the world: O(followed objects) per step, whatever the size of the world. If one fails (an object
-// left the world, or btCollisionWorld::removeCollisionObject's swap-and-pop moved a followed object into
-// another slot), it scans the array once, pointers only, refreshing every index and dropping every
-// attachment and collider whose body is gone, releasing its particles, with one warning per body. So
-// removing a body (and deleting it) between two stepSimulation calls is safe; calling detach(body) first
-// is the tidy way and warns about nothing. (As with any pointer comparison, a new object that reuses a
-// deleted body's address is taken for it: detach(body) before deleting a body that another may replace.)
+/// \file
+/// CapeAction: one cape stepping with a Bullet world. `world->addAction(&action)` is all it takes: Bullet
+/// calls updateAction() once per internal fixed step, after the rigid bodies have moved, and the action
+/// converts what it needs (pin targets from the bodies it is attached to, colliders from the bodies it
+/// touches) and delegates the step to cape::Cape.
+///
+/// Discovery goes through the world's broadphase (btBroadphaseInterface::aabbTest over the cape's grown
+/// bounds; btDbvtBroadphase answers from its AABB trees), so its cost follows the objects near the cape, not
+/// the size of the world. What it finds is ordered by the objects' indices in the world's collision object
+/// array (read while Bullet reports them, so while they are certainly in the world), never by the
+/// broadphase's tree order or by addresses: the followed objects, and so the colliders, keep the order of
+/// first sight, ties in one step broken by array index.
+///
+/// Ownership (Bullet's rule): the user owns the bodies, removes them from the world before deleting them,
+/// and removes the action from the world before destroying it. The action never dereferences a body that
+/// is no longer in the world. It remembers, for every object it follows (attachment bodies and colliders),
+/// the index in the world's collision object array where it last saw it; at the start of every update it
+/// checks `index < size && array[index] == pointer` for each (pointers only). If every check holds, nothing
+/// left the world: O(followed objects) per step, whatever the size of the world. If one fails (an object
+/// left the world, or btCollisionWorld::removeCollisionObject's swap-and-pop moved a followed object into
+/// another slot), it scans the array once, pointers only, refreshing every index and dropping every
+/// attachment and collider whose body is gone, releasing its particles, with one warning per body. So
+/// removing a body (and deleting it) between two stepSimulation calls is safe; calling detach(body) first
+/// is the tidy way and warns about nothing. (As with any pointer comparison, a new object that reuses a
+/// deleted body's address is taken for it: detach(body) before deleting a body that another may replace.)
 #pragma once
 
 #include "cape/bullet/Export.h"
@@ -55,8 +56,8 @@ struct CapeActionSettings {
   /// and mask (Bullet's rule: (object.group & cape.mask) != 0 and (cape.group & object.mask) != 0). Objects
   /// without contact response (CF_NO_CONTACT_RESPONSE: triggers, ghosts) and soft bodies are skipped.
   bool discoverColliders = true;
-  int collisionGroup = btBroadphaseProxy::DefaultFilter;
-  int collisionMask = btBroadphaseProxy::AllFilter;
+  int collisionGroup = btBroadphaseProxy::DefaultFilter;  ///< The cape's collision filter group (bit mask).
+  int collisionMask = btBroadphaseProxy::AllFilter;       ///< The groups the cape collides with (bit mask).
   /// m: how far beyond the cape's particle bounds discovery looks; covers a step's motion of fast bodies.
   btScalar discoveryMargin = btScalar(0.25);
 
@@ -66,12 +67,12 @@ struct CapeActionSettings {
   /// start of every pin's sweep) moves by (1 - inertia) of the reference body's displacement (linear) and of
   /// its rotation about its origin (angular) over the step; velocities turn with that rotation.
   btScalar linearInertia = btScalar(1);
-  btScalar angularInertia = btScalar(1);
+  btScalar angularInertia = btScalar(1);  ///< 0..1: the same for the body's rotation (see linearInertia).
 
   /// A reference body moving farther than this in one step (m), or turning more than teleportAngle (rad),
   /// teleports: the whole cape is moved rigidly with it (Cape::teleport) and no collider is swept.
   btScalar teleportDistance = btScalar(1);
-  btScalar teleportAngle = btScalar(1.0);
+  btScalar teleportAngle = btScalar(1.0);  ///< rad: a turn in one step beyond this teleports (see above).
 
   /// Take gravity from the world the cape steps in (btDynamicsWorld::getGravity(), read before every step),
   /// so a Z-up world or a changed gravity needs nothing more. Off: CapeSettings::gravity stays in force. A
@@ -91,13 +92,17 @@ struct CapeActionSettings {
 
 /// One particle pinned to a rigid body at a point in the body's frame.
 struct Attachment {
-  std::uint32_t particle = 0;
+  std::uint32_t particle = 0;         ///< The pinned particle's index.
   const btRigidBody* body = nullptr;  ///< Never dereferenced once the body left the world.
   btVector3 localPivot{0, 0, 0};      ///< m, in the body's frame.
 };
 
+/// One cape stepping with a Bullet world (a btActionInterface): pins on rigid bodies, colliders from the
+/// bodies it touches, the cloth physics delegated to cape::Cape. See CapeAction.h for discovery and
+/// ownership; positions in metres, world.
 class CAPE_BULLET_API CapeAction : public btActionInterface {
  public:
+  /// What attachNearest() returns when nothing was attached.
   static constexpr std::uint32_t kNoParticle = 0xffffffffu;
 
   /// A cape at the fabric's rest shape placed by `placement` (world = placement * rest), at rest.
@@ -109,15 +114,20 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   CapeAction(const CapeAction&) = delete;
   CapeAction& operator=(const CapeAction&) = delete;
 
+  /// True when the core cape was made (cape().status() says why not).
   bool ok() const { return cape_.ok(); }
+  /// The core cape (settings, pins, state).
   const Cape& cape() const { return cape_; }
   /// The core cape (settings, pins, state). Prefer the attach/detach methods for body pins.
   Cape& cape() { return cape_; }
+  /// The action's own settings.
   const CapeActionSettings& actionSettings() const { return settings_; }
+  /// Replaces the action's settings (read at the next step).
   void setActionSettings(const CapeActionSettings& settings) {
     settings_ = settings;
     changed_ = true;
   }
+  /// Where warnings go (stderr by default; an empty handler drops them).
   void setWarningHandler(WarningHandler handler) { warn_ = std::move(handler); }
 
   // --- Attachments --------------------------------------------------------------------------------------
@@ -137,7 +147,9 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   /// Releases every particle attached to `body` (call before deleting an attached body). Compares
   /// pointers only, so it is safe with a body already deleted.
   void detach(const btCollisionObject* body);
+  /// Releases every attached particle.
   void detachAll();
+  /// Every attachment, in the order they were made.
   const std::vector<Attachment>& attachments() const { return attachments_; }
   /// The body whose motion inertia and teleports refer to: set here, else the first attachment's body.
   void setReferenceBody(const btRigidBody* body) {
@@ -164,15 +176,18 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   void updateAction(btCollisionWorld* world, btScalar dt) override;
   /// Draws every triangle's edges (m, world) in the colour given.
   void debugDraw(btIDebugDraw* drawer) override;
+  /// The colour debugDraw() uses (RGB, 0..1).
   void setDebugColor(const btVector3& color) { debugColor_ = color; }
 
   /// The two halves of updateAction, for CapeGroup: prepare() reads the world (bodies still present,
   /// their poses, collider discovery) and must run on one thread; advance() touches only this cape and
   /// the shapes' read-only data, so several capes may advance at once on different threads.
   void prepare(btCollisionWorld* world, btScalar dt);
+  /// The second half of updateAction (dt s): steps the core cape against the colliders prepare() built.
   void advance(btScalar dt);
 
   // --- Results -----------------------------------------------------------------------------------------
+  /// The number of particles (0 when not ok()).
   std::size_t particleCount() const { return cape_.ok() ? cape_.fabric().particleCount() : 0; }
   /// Particle positions, m, world (one row per particle, columns x, y, z), as floats. The solver's own are
   /// cape().state().positions, relative to cape().origin(); with a frame away from the world's origin this
@@ -184,6 +199,7 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   /// origin - frameOrigin(), exact however far): build a cape placed relative to a point far from the world's
   /// origin, then relocate it there, and it keeps every bit of its shape. Ignored unless finite.
   void relocate(const Eigen::Vector3d& origin);
+  /// One particle's position, m, world ((0, 0, 0) for an index out of range).
   btVector3 position(std::uint32_t particle) const;
   /// Wall time of the cape's own work in the last internal step (prepare() and advance()), microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }

@@ -1,8 +1,9 @@
-// CapeGroup: several capes stepped with one Bullet world, in parallel. Add the group to the world
-// (world->addAction(&group)) instead of each cape. Every internal step, the group prepares each cape on the
-// calling thread (reading the world is not shared out), then advances them on a small persistent pool:
-// cape i always runs on worker i % threadCount (a fixed static partition). Each cape is independent and its
-// own computation is sequential, so the results are bitwise identical whatever the thread count.
+/// \file
+/// CapeGroup: several capes stepped with one Bullet world, in parallel. Add the group to the world
+/// (world->addAction(&group)) instead of each cape. Every internal step, the group prepares each cape on the
+/// calling thread (reading the world is not shared out), then advances them on a small persistent pool:
+/// cape i always runs on worker i % threadCount (a fixed static partition). Each cape is independent and its
+/// own computation is sequential, so the results are bitwise identical whatever the thread count.
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
@@ -15,6 +16,8 @@
 
 namespace cape::bullet {
 
+/// Several capes stepped with one Bullet world on a persistent thread pool, bitwise identical results on any
+/// thread count (see CapeGroup.h). Add the group to the world instead of its capes.
 class CAPE_BULLET_API CapeGroup : public btActionInterface {
  public:
   /// threadCount >= 1 workers in all, the calling thread included (threadCount - 1 threads are started).
@@ -25,11 +28,17 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
 
   /// Adds a cape (not owned; it must outlive its membership and must not be added to the world itself).
   void add(CapeAction* cape);
+  /// Removes a cape from the group (not destroyed; nothing happens if it is not a member).
   void remove(CapeAction* cape);
+  /// The member capes, in the order they were added (cape i runs on worker i % threadCount()).
   const std::vector<CapeAction*>& capes() const { return capes_; }
+  /// Workers in all, the calling thread included.
   int threadCount() const { return threadCount_; }
 
+  /// One internal step of the world (dt s): every cape's prepare() on this thread, then their advance() on
+  /// the pool.
   void updateAction(btCollisionWorld* world, btScalar dt) override;
+  /// Draws every member cape (CapeAction::debugDraw).
   void debugDraw(btIDebugDraw* drawer) override;
   /// Wall time of the last parallel advance of all capes, microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }

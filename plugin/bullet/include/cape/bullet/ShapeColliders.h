@@ -1,10 +1,11 @@
-// Bullet collision shapes as cape colliders, all resolved by the core inside its substeps. Shapes the core
-// knows analytically (sphere, box, capsule, cylinder, a static plane; compounds, nested) become those
-// colliders; every other convex shape becomes a core convex hull (a btConvexHullShape's own points, any
-// other shape's support mapping sampled in 162 directions), its collision margin the collider's thickness;
-// triangle meshes (btBvhTriangleMeshShape, btScaledBvhTriangleMeshShape, heightfields) become core
-// triangle-mesh colliders whose triangles near the cape the action gathers with Bullet's mesh queries once
-// per step.
+/// \file
+/// Bullet collision shapes as cape colliders, all resolved by the core inside its substeps. Shapes the core
+/// knows analytically (sphere, box, capsule, cylinder, a static plane; compounds, nested) become those
+/// colliders; every other convex shape becomes a core convex hull (a btConvexHullShape's own points, any
+/// other shape's support mapping sampled in 162 directions), its collision margin the collider's thickness;
+/// triangle meshes (btBvhTriangleMeshShape, btScaledBvhTriangleMeshShape, heightfields) become core
+/// triangle-mesh colliders whose triangles near the cape the action gathers with Bullet's mesh queries once
+/// per step.
 #pragma once
 
 #include "cape/bullet/Export.h"
@@ -24,17 +25,20 @@ namespace cape::bullet {
 /// What one Bullet shape becomes. Every part carries its transform in the shape's (the object's) frame, so
 /// that its world pose is objectWorldTransform * local.
 struct ShapeConversion {
+  /// An analytic shape or a convex hull.
   struct Primitive {
     Collider collider;  ///< Sizes filled in; poses are set every step.
-    btTransform local;
+    btTransform local;  ///< Its pose in the object's frame (m).
   };
+  /// A triangle mesh or a heightfield.
   struct Mesh {
     const btConcaveShape* shape;  ///< Queried for its triangles near the cape every step.
-    btTransform local;
+    btTransform local;            ///< Its pose in the object's frame (m).
   };
   std::vector<Primitive> primitives;     ///< Analytic shapes and convex hulls, swept by the core.
   std::vector<Mesh> meshes;              ///< Triangle meshes and heightfields.
   std::vector<std::string> unsupported;  ///< Names (btCollisionShape::getName) of shapes left out, and why.
+  /// True when the shape gave nothing to collide with.
   bool empty() const { return primitives.empty() && meshes.empty(); }
 };
 

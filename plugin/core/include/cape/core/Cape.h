@@ -1,6 +1,7 @@
-// Cape: one simulated cape — a shared Fabric, its own settings and state — and its staged step. The solver's
-// scratch memory (the step's buffers, the body- and self-collision subsystems) lives in the core's sources,
-// sized once when the cape is made, so that stepping never allocates.
+/// \file
+/// Cape: one simulated cape — a shared Fabric, its own settings and state — and its staged step. The solver's
+/// scratch memory (the step's buffers, the body- and self-collision subsystems) lives in the core's sources,
+/// sized once when the cape is made, so that stepping never allocates.
 #pragma once
 
 #include "cape/core/CapeSettings.h"
@@ -21,38 +22,53 @@ struct CapeScratch;
 
 /// A view of the colliders for one step (the caller owns them; see Collider::moveTo).
 struct ColliderSpan {
-  const Collider* data = nullptr;
-  std::size_t size = 0;
-  ColliderSpan() = default;
+  const Collider* data = nullptr;  ///< The first collider.
+  std::size_t size = 0;            ///< How many there are.
+  ColliderSpan() = default;        ///< No colliders.
+  /// `n` colliders from `d`.
   ColliderSpan(const Collider* d, std::size_t n) : data(d), size(n) {}
+  /// Every collider of `v` (which must outlive the span).
   ColliderSpan(const std::vector<Collider>& v)
       : data(v.data()), size(v.size()) {}  // NOLINT: implicit by design
+  /// The first collider, for range-for.
   const Collider* begin() const { return data; }
+  /// One past the last collider.
   const Collider* end() const { return data + size; }
 };
 
+/// One simulated cape: a shared Fabric, its own CapeSettings and CapeState, and the staged step (prediction,
+/// constraints, collisions, velocities over substeps; docs/SOLVER.md). Positions are in the cape's frame
+/// (origin()), m. Movable, not copyable; stepping never allocates.
 class CAPE_CORE_API Cape {
  public:
   /// Makes a cape at the fabric's rest shape placed by `placement` (world = placement * rest), at rest.
   /// Check `status()`: on bad settings or fabric the cape is empty and step() does nothing.
   Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement = Pose());
   ~Cape();
+  /// Moves the cape (fabric, settings, state and scratch) into this one; use only the new one.
   Cape(Cape&&) noexcept;
+  /// Moves the cape (fabric, settings, state and scratch) into this one; use only the new one.
   Cape& operator=(Cape&&) noexcept;
   Cape(const Cape&) = delete;
   Cape& operator=(const Cape&) = delete;
 
+  /// Why the cape is empty, or success.
   const Status& status() const { return status_; }
+  /// True when the cape was made (status() is success).
   bool ok() const { return status_.ok(); }
 
+  /// The shared fabric (only while ok()).
   const Fabric& fabric() const { return *fabric_; }
+  /// The shared fabric's pointer.
   const FabricPtr& fabricPtr() const { return fabric_; }
+  /// The settings in use.
   const CapeSettings& settings() const { return settings_; }
   /// Changes the settings; rejected (returning the error, keeping the old settings) if invalid.
   Status setSettings(const CapeSettings& settings);
   /// Gravity for the next steps (m/s^2, world frame), e.g. the world's, read before every step. Not finite:
   /// an error, and the gravity stays what it was.
   Status setGravity(const Vec3& gravity);
+  /// Positions, velocities, inverse masses, pins and time (frame coordinates, m, m/s, 1/kg, s).
   const CapeState& state() const { return state_; }
   /// Direct access for tools and tests; keep inverse masses and pins consistent (use pin()/unpin()). Wakes
   /// the cape (whatever is done with the state may move it).
@@ -111,6 +127,7 @@ class CAPE_CORE_API Cape {
     std::uint64_t total = 0;     ///< particles restored since the cape was made
     std::uint64_t steps = 0;     ///< steps that restored at least one
   };
+  /// What the numerical guard has done (see GuardReport).
   const GuardReport& guard() const { return guard_; }
   /// Where the rest shape stands (frame coordinates; world = pose * rest): the placement, moved by
   /// teleport() and carry(), and refitted to the pin targets whenever the guard restores a particle.
@@ -119,19 +136,21 @@ class CAPE_CORE_API Cape {
   /// Sleeping (CapeSettings::sleepSpeed): whether the cape is asleep, and how many steps it slept through
   /// (each only a check that its pins and colliders are still where they were when it fell asleep).
   bool isAsleep() const { return asleep_; }
+  /// Steps the cape slept through since it was made.
   std::uint64_t sleptSteps() const { return sleptSteps_; }
   /// Wakes the cape (the next step simulates); what every change to the pins, settings or state does.
   void wake();
 
   /// A particle that touched a collider in this substep's collision pass (index into the step's colliders).
   struct Contact {
-    std::uint32_t particle;
-    std::uint32_t collider;
+    std::uint32_t particle;  ///< The particle's index.
+    std::uint32_t collider;  ///< The collider's index in the step's ColliderSpan.
   };
 
   /// How many times the settings' substeps the next step takes (strain-adaptive substepping), and the max
   /// structural strain measured after the last step.
   int substepRefinement() const { return refinement_; }
+  /// The largest structural strain after the last step ((|xi - xj| - L0) / L0, dimensionless).
   float lastMaxStrain() const { return lastMaxStrain_; }
 
   /// The self-collision thickness in use, m (the setting, or its automatic value).
@@ -140,12 +159,13 @@ class CAPE_CORE_API Cape {
   /// start of the step, with the side of the triangle it was on then (+1, -1, or 0 while its nearest point
   /// is on the triangle's boundary). The solver keeps it on that side, at least the thickness away.
   struct SelfContact {
-    std::uint32_t particle;
-    std::uint32_t triangle;
-    float side;
+    std::uint32_t particle;  ///< The particle's index.
+    std::uint32_t triangle;  ///< Triangle t: corners Fabric::triangles()[3t .. 3t + 2].
+    float side;              ///< +1, -1 or 0 (see above).
   };
   /// Self-contacts found by the last search (diagnostics, benchmarks and tests).
   const std::vector<SelfContact>& selfContacts() const;
+  /// The number of self-contacts found by the last search.
   std::size_t selfContactCount() const { return selfContacts().size(); }
   /// Self-contact searches run so far (a search's contacts are kept over the steps its margin covers).
   std::uint64_t selfContactSearches() const;

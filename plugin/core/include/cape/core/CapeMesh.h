@@ -1,6 +1,7 @@
-// Render output of a cape, refreshed every frame without allocating: positions, area-weighted vertex
-// normals, UVs and counter-clockwise triangles; optionally a two-sided copy for renderers without
-// two-sided shading (back faces with flipped winding and flipped normals).
+/// \file
+/// Render output of a cape, refreshed every frame without allocating: positions, area-weighted vertex
+/// normals, UVs and counter-clockwise triangles; optionally a two-sided copy for renderers without
+/// two-sided shading (back faces with flipped winding and flipped normals).
 #pragma once
 
 #include "cape/core/Export.h"
@@ -8,10 +9,11 @@
 
 namespace cape {
 
+/// Render output of a cape, refreshed every frame without allocating (see CapeMesh.h).
 struct CAPE_CORE_API CapeMesh {
-  Points positions;  ///< m, one row per vertex.
-  Points normals;    ///< Unit, one row per vertex.
-  std::vector<Eigen::Vector2f> uvs;
+  Points positions;                    ///< m, one row per vertex.
+  Points normals;                      ///< Unit, one row per vertex.
+  std::vector<Eigen::Vector2f> uvs;    ///< Texture coordinates, one per vertex (the fabric's).
   std::vector<std::uint32_t> indices;  ///< 3 per triangle, counter-clockwise around the normal.
 
   /// Sizes the buffers for the fabric (front only, or front then back when twoSided) and fills the
@@ -20,6 +22,7 @@ struct CAPE_CORE_API CapeMesh {
   /// Copies positions and recomputes normals from the given particle positions. Never allocates once
   /// allocate() has been called for this fabric.
   void update(const Fabric& fabric, const Points& particlePositions);
+  /// Whether the buffers hold a back copy (allocate()'s `twoSided`).
   bool twoSided() const { return twoSided_; }
 
  private:

@@ -1,4 +1,5 @@
-// CapeSettings: per-cape parameters, plain data with units. Checked by validate() before every run.
+/// \file
+/// CapeSettings: per-cape parameters, plain data with units. Checked by validate() before every run.
 #pragma once
 
 #include "cape/core/Export.h"
@@ -17,12 +18,18 @@ enum class Integrator : int {
   /// stability bound.
   ExplicitSpring = 1,
 };
+/// The integrator's name: "xpbd" or "explicit" ("?" for a value outside the enum).
 CAPE_CORE_API const char* toString(Integrator integrator);
 
 /// Wind acting on the cape (the aerodynamic model lives with the solver; this is its data).
 struct WindSettings {
-  enum class Model : int { None = 0, SineWave = 1, Aerodynamic = 2 };
-  Model model = Model::None;
+  /// The wind models (cape/core/Wind.h gives their equations).
+  enum class Model : int {
+    None = 0,         ///< No wind.
+    SineWave = 1,     ///< Uniform air with a sine gust, quadratic drag per particle (the seed's model).
+    Aerodynamic = 2,  ///< Drag and lift per triangle in a gusty, turbulent field.
+  };
+  Model model = Model::None;       ///< Which model acts; None: no wind.
   Vec3 direction = Vec3::UnitX();  ///< Unit direction of the mean wind.
   float speed = 0.0f;              ///< Mean wind speed, m/s.
   float gustAmplitude = 0.0f;      ///< Relative gust strength (0.5 = +-50 %).
@@ -34,15 +41,17 @@ struct WindSettings {
   unsigned seed = 1;               ///< Seeds the deterministic gust field.
 };
 
+/// Per-cape parameters, plain data with units; validate() checks them (Cape checks them when it is made and
+/// on setSettings()).
 struct CAPE_CORE_API CapeSettings {
-  Integrator integrator = Integrator::Xpbd;
+  Integrator integrator = Integrator::Xpbd;  ///< How the equations of motion are integrated.
 
   /// Spring stiffness per family, N/m per spring (Hooke's k). XPBD uses the compliance 1/k; infinity means
   /// inextensible. Families: structural, shear, bend.
   float structuralStiffness = 2.0e4f;
-  float shearStiffness = 2.0e3f;
-  float bendStiffness = 20.0f;
-  bool useTethers = true;  ///< Long-range attachments to pinned anchors (XPBD only).
+  float shearStiffness = 2.0e3f;  ///< N/m per shear spring (see structuralStiffness).
+  float bendStiffness = 20.0f;    ///< N/m per bend spring (see structuralStiffness).
+  bool useTethers = true;         ///< Long-range attachments to pinned anchors (XPBD only).
 
   /// Linear velocity damping, 1/s: dv/dt = -damping * v (applied as v /= 1 + damping * h). Stands in for
   /// the air's drag when no aerodynamic wind model is on: a 0.4 kg, 0.6 m^2 cape moving at 1 m/s through
@@ -52,7 +61,7 @@ struct CAPE_CORE_API CapeSettings {
   float damping = 2.0f;
   /// Cape half-thickness kept between particles and collider surfaces, m.
   float collisionThickness = 0.01f;
-  /// Coulomb friction coefficient against colliders.
+  /// Coulomb friction coefficient against colliders (dimensionless, >= 0).
   float friction = 0.3f;
   /// Substeps per `timeStep`, >= 1: step(dt) takes ceil(dt / (timeStep / substeps)) substeps of equal
   /// length, so a Bullet world stepping at 1/240 s takes one per internal step where a 1/60 s frame takes
@@ -86,7 +95,7 @@ struct CAPE_CORE_API CapeSettings {
   /// checks the explicit mode's stability bound at timeStep / substeps.
   float timeStep = 1.0f / 60.0f;
 
-  WindSettings wind;
+  WindSettings wind;  ///< The wind acting on the cape (none by default).
   /// Keep the cape from passing through itself: particle-triangle contacts found through a spatial hash at
   /// the start of every step and kept on their side through its substeps (predictive contacts, Lewin 2018).
   bool selfCollision = false;
@@ -101,6 +110,8 @@ struct CAPE_CORE_API CapeSettings {
   /// frame. (Nothing to do with the wind's random `WindSettings::seed`.)
   static CapeSettings unitySeed();
 
+  /// Checks every field against its range (finite, positive where a unit needs it, the explicit mode's
+  /// stability bound); the error names the field.
   Status validate() const;
 };
 

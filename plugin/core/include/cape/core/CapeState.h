@@ -1,4 +1,5 @@
-// CapeState: the per-cape runtime state as structure of arrays.
+/// \file
+/// CapeState: the per-cape runtime state as structure of arrays.
 #pragma once
 
 #include "cape/core/Export.h"
@@ -12,11 +13,12 @@ namespace cape {
 /// A particle driven to a moving target. Pinned particles have inverse mass 0: nothing else moves them.
 /// Within a step the target moves from `previousTarget` (start of the step) to `target` (end of the step).
 struct Pin {
-  std::uint32_t particle = 0;
+  std::uint32_t particle = 0;          ///< The pinned particle's index.
   Vec3 previousTarget = Vec3::Zero();  ///< m, world.
   Vec3 target = Vec3::Zero();          ///< m, world.
 };
 
+/// The per-cape runtime state, one row (or entry) per particle, in the cape's frame (Cape::origin).
 struct CapeState {
   Points positions;               ///< m, world.
   Points velocities;              ///< m/s.

@@ -1,7 +1,8 @@
-// Colliders: analytic shapes the cape collides with, each with the pose it had at the start of the step
-// (`previous`) and the pose it has at its end (`current`). The solver interpolates between them across its
-// substeps and tests each particle against the collider's sweep, so fast motion cannot carry a particle
-// through.
+/// \file
+/// Colliders: analytic shapes the cape collides with, each with the pose it had at the start of the step
+/// (`previous`) and the pose it has at its end (`current`). The solver interpolates between them across its
+/// substeps and tests each particle against the collider's sweep, so fast motion cannot carry a particle
+/// through.
 #pragma once
 
 #include "cape/core/Export.h"
@@ -13,7 +14,17 @@
 
 namespace cape {
 
-enum class ColliderShape : int { Sphere, Capsule, Cylinder, Box, Plane, ConvexHull, TriangleMesh };
+/// The kinds of collider (Collider gives each one's surface).
+enum class ColliderShape : int {
+  Sphere,        ///< A ball about the collider's origin.
+  Capsule,       ///< A segment along an axis, rounded by a radius.
+  Cylinder,      ///< A flat-ended cylinder along an axis.
+  Box,           ///< An axis-aligned box in the collider's frame.
+  Plane,         ///< A world half-space.
+  ConvexHull,    ///< A convex polytope (ConvexHull).
+  TriangleMesh,  ///< Two-sided triangles (TriangleSoup), no inside.
+};
+/// The shape's name: "sphere", "capsule", ...
 CAPE_CORE_API const char* toString(ColliderShape shape);
 
 /// A convex polytope in its collider's frame: the points it is the hull of, and its outward face planes
@@ -34,7 +45,8 @@ struct CAPE_CORE_API ConvexHull {
 /// Triangles of a mesh near the cape, in their collider's frame: corners[3 t .. 3 t + 2] is triangle t, m.
 /// Whoever gathers them (the Bullet adapter, from its mesh queries once per step) refills it between steps.
 struct TriangleSoup {
-  std::vector<Vec3> corners;
+  std::vector<Vec3> corners;  ///< m, three per triangle.
+  /// The number of triangles.
   std::size_t size() const { return corners.size() / 3; }
 };
 
@@ -42,6 +54,7 @@ struct TriangleSoup {
 /// particles are kept out of (on top of the cape's own collision thickness).
 ///
 /// Local shapes (in the collider's own frame):
+/// \verbatim
 ///   Sphere   |p| = radius
 ///   Capsule  points within `radius` of the segment from -halfHeight to +halfHeight along `axis`
 ///            (halfHeight is half the distance between the two sphere centres, as btCapsuleShape)
@@ -53,14 +66,15 @@ struct TriangleSoup {
 ///   TriangleMesh  `triangles`, two-sided: each particle keeps the side of every nearby triangle it was on
 ///                 at the start of the step (so a thin wall or a floor cannot be passed through), at least
 ///                 the thicknesses away from it; no inside
+/// \endverbatim
 struct CAPE_CORE_API Collider {
-  ColliderShape shape = ColliderShape::Sphere;
-  float radius = 0.0f;
-  float halfHeight = 0.0f;
-  int axis = 1;  ///< 0 = X, 1 = Y, 2 = Z (capsule and cylinder).
-  Vec3 halfExtents = Vec3::Zero();
-  Vec3 normal = Vec3::UnitY();
-  float constant = 0.0f;
+  ColliderShape shape = ColliderShape::Sphere;    ///< Which surface the fields below describe.
+  float radius = 0.0f;                            ///< m: sphere, capsule and cylinder.
+  float halfHeight = 0.0f;                        ///< m: capsule and cylinder, along `axis`.
+  int axis = 1;                                   ///< 0 = X, 1 = Y, 2 = Z (capsule and cylinder).
+  Vec3 halfExtents = Vec3::Zero();                ///< m: box, along the collider's x, y, z.
+  Vec3 normal = Vec3::UnitY();                    ///< Plane: unit normal, world (out of the solid).
+  float constant = 0.0f;                          ///< Plane: n . x = constant on the surface, m.
   std::shared_ptr<const ConvexHull> hull;         ///< ConvexHull only.
   std::shared_ptr<const TriangleSoup> triangles;  ///< TriangleMesh only.
   float thickness = 0.0f;                         ///< m, >= 0.
@@ -69,13 +83,19 @@ struct CAPE_CORE_API Collider {
   Pose current;            ///< Pose at the end of the step.
   std::string name;        ///< For reports only.
 
+  /// A sphere of `radius` m at `pose` (both poses), not moving.
   static Collider sphere(float radius, const Pose& pose = Pose());
+  /// A capsule: `radius` m around the segment +-`halfHeight` m along `axis` (0 = X, 1 = Y, 2 = Z).
   static Collider capsule(float radius, float halfHeight, int axis, const Pose& pose = Pose());
+  /// A cylinder of `radius` m from -`halfHeight` to +`halfHeight` m along `axis` (0 = X, 1 = Y, 2 = Z).
   static Collider cylinder(float radius, float halfHeight, int axis, const Pose& pose = Pose());
+  /// A box of `halfExtents` m along its x, y, z.
   static Collider box(const Vec3& halfExtents, const Pose& pose = Pose());
   /// The world plane n . x = constant, solid below (n is normalised here).
   static Collider plane(const Vec3& normal, float constant);
+  /// A convex hull (shared, not copied) at `pose`.
   static Collider convexHull(std::shared_ptr<const ConvexHull> hull, const Pose& pose = Pose());
+  /// Two-sided triangles (shared; the gatherer refills them between steps) at `pose`.
   static Collider triangleMesh(std::shared_ptr<const TriangleSoup> triangles, const Pose& pose = Pose());
 
   /// The collider has moved: the pose at the end of the last step becomes the start of the next.
@@ -94,16 +114,18 @@ struct CAPE_CORE_API Collider {
 /// outward unit normal of the nearest surface point (the nearest surface point is p - distance * normal).
 /// A triangle mesh has no inside: the distance to its nearest triangle (+inf for an empty one).
 struct SurfaceDistance {
-  float distance;
-  Vec3 normal;
+  float distance;  ///< m, negative inside.
+  Vec3 normal;     ///< Unit, outward, in the collider's frame.
 };
+/// The signed distance and normal of a point given in the collider's frame (see SurfaceDistance).
 CAPE_CORE_API SurfaceDistance localSignedDistance(const Collider& collider, const Vec3& localPoint);
 
-/// Signed distance from a world point to the collider's true surface at its current pose.
+/// Signed distance from a world point to the collider's true surface at its current pose, m (negative
+/// inside).
 CAPE_CORE_API float signedDistance(const Collider& collider, const Vec3& worldPoint);
 
-/// The nearest point of the collider's surface to a world point, at its current pose (the seed's push-out
-/// target when the thickness is zero).
+/// The nearest point of the collider's surface to a world point, at its current pose, m, world (the seed's
+/// push-out target when the thickness is zero).
 CAPE_CORE_API Vec3 closestSurfacePoint(const Collider& collider, const Vec3& worldPoint);
 
 }  // namespace cape

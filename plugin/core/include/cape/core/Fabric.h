@@ -1,5 +1,6 @@
-// Fabric: the shared, immutable topology and rest state of a cape (NvCloth's Fabric, Jolt's
-// SoftBodySharedSettings). Many capes may share one Fabric; per-cape data lives in CapeState.
+/// \file
+/// Fabric: the shared, immutable topology and rest state of a cape (NvCloth's Fabric, Jolt's
+/// SoftBodySharedSettings). Many capes may share one Fabric; per-cape data lives in CapeState.
 #pragma once
 
 #include "cape/core/Export.h"
@@ -13,8 +14,14 @@
 namespace cape {
 
 /// The families of springs. Structural and shear together form the seed's King's graph for a grid.
-enum class SpringFamily : int { Structural = 0, Shear = 1, Bend = 2 };
+enum class SpringFamily : int {
+  Structural = 0,  ///< Along rows and columns (a mesh's edges): what holds the cloth's length.
+  Shear = 1,       ///< Across each grid cell's diagonals.
+  Bend = 2,        ///< Between every second particle (a mesh's far vertices across an edge).
+};
+/// The number of spring families (the size of per-family arrays).
 constexpr int kSpringFamilyCount = 3;
+/// The family's name: "structural", "shear" or "bend".
 CAPE_CORE_API const char* toString(SpringFamily family);
 
 /// How the solver reads the particles of a run of springs. Every block of four consecutive springs of one
@@ -34,9 +41,9 @@ enum class SpringLayout : std::uint8_t {
 
 /// Springs [begin, end) of a set, read with one layout. A vector run holds a whole number of blocks of four.
 struct SpringRun {
-  std::uint32_t begin = 0;
-  std::uint32_t end = 0;
-  SpringLayout layout = SpringLayout::Scalar;
+  std::uint32_t begin = 0;                     ///< The run's first spring (index into the set).
+  std::uint32_t end = 0;                       ///< One past its last spring.
+  SpringLayout layout = SpringLayout::Scalar;  ///< How the solver reads the run's particles.
 };
 
 /// Springs of one family as parallel arrays (structure of arrays), solved in this order. The build sorts
@@ -51,7 +58,9 @@ struct SpringSet {
   /// Solving the runs in order is solving the springs in order: the four springs of a block share no
   /// particle, so solving them together gives the same bits as one after another.
   std::vector<SpringRun> runs;
+  /// The number of springs.
   std::size_t size() const { return first.size(); }
+  /// The number of colours.
   std::size_t colourCount() const { return colourStart.empty() ? 0 : colourStart.size() - 1; }
 };
 
@@ -59,9 +68,10 @@ struct SpringSet {
 /// Inextensible Clothing in Computer Games"): particle `particle` may not be farther than `maxLength` from
 /// particle `anchor` while the anchor is pinned. A unilateral constraint, so it never pushes.
 struct TetherSet {
-  std::vector<std::uint32_t> particle;
-  std::vector<std::uint32_t> anchor;
-  std::vector<float> maxLength;  ///< m; the rest distance times the tether scale.
+  std::vector<std::uint32_t> particle;  ///< The tethered particle of each tether.
+  std::vector<std::uint32_t> anchor;    ///< The anchor particle it may not drift from.
+  std::vector<float> maxLength;         ///< m; the rest distance times the tether scale.
+  /// The number of tethers.
   std::size_t size() const { return particle.size(); }
 };
 
@@ -79,11 +89,11 @@ struct GridDesc {
   float tetherScale = 1.0f;    ///< Tether length = scale * rest distance (>= 1 allows that much stretch).
 };
 
-/// How to build a fabric from any triangle mesh (an artist's cape).
 /// The largest rest coordinate a fabric may have, m: a fabric is metres; beyond this a float square (a
 /// spring's squared length) overflows.
 constexpr float kMaxFabricCoordinate = 1e6f;
 
+/// How to build a fabric from any triangle mesh (an artist's cape).
 struct MeshDesc {
   std::vector<Vec3> positions;  ///< Rest positions, m, each coordinate within +-kMaxFabricCoordinate.
   std::vector<std::uint32_t>
@@ -91,35 +101,40 @@ struct MeshDesc {
   std::vector<Eigen::Vector2f> uvs;  ///< Optional, one per vertex.
   float totalMass = 0.4f;            ///< kg, spread over vertices in proportion to their triangle area.
   bool bendSprings = true;           ///< Far vertices of each pair of adjacent triangles.
-  std::vector<std::uint32_t> tetherAnchors;
-  int tethersPerParticle = 2;
-  float tetherScale = 1.0f;
+  std::vector<std::uint32_t> tetherAnchors;  ///< Vertices tethers are made to (as GridDesc's); empty: none.
+  int tethersPerParticle = 2;                ///< Each vertex tethers to this many nearest anchors.
+  float tetherScale = 1.0f;  ///< Tether length = scale * rest distance (>= 1 allows that much stretch).
 };
 
 /// The particles a triangle never makes self-contacts with: its three corners and, for each edge k, the far
 /// corner of the triangle across it in v[3 + k] (~0u on the border or a non-manifold edge); v[6], v[7] are
 /// ~0u padding, so that membership is two 4-lane compares.
 struct alignas(16) TriangleLocalSet {
-  std::uint32_t v[8];
+  std::uint32_t v[8];  ///< Particle indices (corners, far corners, ~0u padding).
 };
 
 /// Triangles the self-collision search bins together: two consecutive triangles sharing an edge (a grid
 /// cell's halves) or one alone. `local` holds the particles local to every triangle of the cluster (a grid
 /// cell's four corners; ~0u padding), which meet nothing in it.
 struct alignas(16) ClusterLocalSet {
-  std::uint32_t v[4];
+  std::uint32_t v[4];  ///< Particle indices (~0u padding).
 };
 
 class Fabric;
+/// A shared, immutable fabric: any number of capes may use one.
 using FabricPtr = std::shared_ptr<const Fabric>;
 
 /// The result of building a fabric: the fabric, or an error message.
 struct FabricResult {
-  FabricPtr fabric;
-  Status status = Status::success();
+  FabricPtr fabric;                   ///< The fabric; null on error.
+  Status status = Status::success();  ///< Why there is no fabric.
+  /// True when a fabric was built.
   explicit operator bool() const { return fabric != nullptr; }
 };
 
+/// The shared, immutable topology and rest state of a cape: particles and masses, springs by family, tethers,
+/// triangles and UVs, and the tables the solver derives from them. Built only by grid() or fromMesh(), which
+/// run the derived-data pass, so an unfinished fabric cannot exist.
 class CAPE_CORE_API Fabric {
  public:
   /// Builds an N x M grid in its local frame: particle (r, c) has index r * columns + c and rest position
@@ -132,24 +147,33 @@ class CAPE_CORE_API Fabric {
   /// triangles sharing an edge a bend spring. No shear family (the triangles' edges already brace them).
   static FabricResult fromMesh(const MeshDesc& desc);
 
+  /// The number of particles.
   std::size_t particleCount() const { return static_cast<std::size_t>(restPositions_.rows()); }
+  /// Rest positions in the fabric's local frame, m, one row per particle.
   const Points& restPositions() const { return restPositions_; }
   const Eigen::VectorXf& masses() const { return masses_; }  ///< kg per particle (> 0).
+  /// The springs of one family, in solver order.
   const SpringSet& springs(SpringFamily family) const { return springs_[static_cast<int>(family)]; }
   std::size_t springCount() const;  ///< All families together.
+  /// The long-range attachments (empty without tether anchors).
   const TetherSet& tethers() const { return tethers_; }
   const std::vector<std::uint32_t>& triangles() const { return triangles_; }  ///< 3 per triangle, CCW.
+  /// The number of triangles.
   std::size_t triangleCount() const { return triangles_.size() / 3; }
+  /// Texture coordinates, one per particle (a grid's span [0, 1]; a mesh's as given, or all 0).
   const std::vector<Eigen::Vector2f>& uvs() const { return uvs_; }
+  /// The sum of the particle masses, kg.
   float totalMass() const { return static_cast<float>(masses_.sum()); }
   /// Grid dimensions, when built by grid(); 0 otherwise.
   int gridColumns() const { return gridColumns_; }
+  /// Grid rows, when built by grid(); 0 otherwise.
   int gridRows() const { return gridRows_; }
   /// The largest distance between two particles at rest (bounds how far any particle can be from a pin).
   float restDiameter() const { return restDiameter_; }
   /// The connected component of each particle through the springs of every family, labelled 0, 1, ... in the
   /// order of their first particle; componentCount() of them.
   const std::vector<std::uint32_t>& components() const { return components_; }
+  /// The number of connected components.
   std::uint32_t componentCount() const { return componentCount_; }
   /// Mean rest length of the structural springs, m (sizes the self-collision hash and thickness).
   float meanSpacing() const { return meanSpacing_; }
@@ -159,7 +183,9 @@ class CAPE_CORE_API Fabric {
   const std::vector<TriangleLocalSet>& triangleLocal() const { return triangleLocal_; }
   /// Cluster g is triangles [clusterStart()[g], clusterStart()[g + 1]) (clusterCount() + 1 offsets).
   const std::vector<std::uint32_t>& clusterStart() const { return clusterStart_; }
+  /// The number of clusters.
   std::size_t clusterCount() const { return clusterStart_.empty() ? 0 : clusterStart_.size() - 1; }
+  /// Per cluster, the particles local to all its triangles.
   const std::vector<ClusterLocalSet>& clusterLocal() const { return clusterLocal_; }
 
  private:

@@ -1,10 +1,12 @@
-// FabricPresets: real fabrics as per-area material data (from published measurements), and their mapping onto
-// the solver's per-spring stiffnesses for a grid of a given spacing, so that a coarse and a fine cape of one
-// fabric bend alike. The derivations are in docs/SOLVER.md, "Fabric presets"; each preset's sources are in
-// FabricPresets.cpp beside its numbers.
+/// \file
+/// FabricPresets: real fabrics as per-area material data (from published measurements), and their mapping
+/// onto the solver's per-spring stiffnesses for a grid of a given spacing, so that a coarse and a fine cape
+/// of one fabric bend alike. The derivations are in docs/SOLVER.md, "Fabric presets"; each preset's sources
+/// are in FabricPresets.cpp beside its numbers.
 #pragma once
 
 #include "cape/core/CapeSettings.h"
+#include "cape/core/Export.h"
 
 #include <string>
 #include <string_view>
@@ -14,7 +16,7 @@ namespace cape {
 
 /// A real fabric, per unit area: independent of any grid. Warp and weft are taken alike (the mean of the two
 /// directions where a source gives both).
-struct FabricMaterial {
+struct CAPE_CORE_API FabricMaterial {
   std::string name;               ///< "silk", "cotton", "wool", "denim", "leather"
   float arealDensity = 0.0f;      ///< kg/m^2: mass per area (KES-F W; 1 mg/cm^2 = 0.01 kg/m^2).
   float stretchStiffness = 0.0f;  ///< N/m: membrane tensile stiffness, force per width per unit strain.
@@ -40,32 +42,39 @@ constexpr float kStandardGravity = 9.80665f;
 
 /// The presets: silk, cotton (shirting), wool (suiting), denim, leather, from the most drapey to the
 /// stiffest.
-const std::vector<FabricMaterial>& fabricPresets();
+CAPE_CORE_API const std::vector<FabricMaterial>& fabricPresets();
 /// The preset of that name (exact, lower case, as fabricNames() lists), nullptr if unknown.
-const FabricMaterial* findFabric(std::string_view name);
+CAPE_CORE_API const FabricMaterial* findFabric(std::string_view name);
 /// The presets' names, comma separated ("silk, cotton, ..."): for --help and error messages.
-std::string fabricNames();
+CAPE_CORE_API std::string fabricNames();
 
 /// The settings of a cape of material `m` on a grid whose rest spacing is `spacing` (m; Fabric::meanSpacing()
 /// of a square grid): per-spring structural, shear and bend stiffness derived from the material for that
 /// spacing, the fabric's damping and the wind's drag and lift coefficients; every other field is `base`'s.
 /// Bad input (an invalid material, spacing not finite and > 0) returns `base` unchanged: checkFabric() says
 /// why.
-CapeSettings applyFabric(const FabricMaterial& m, float spacing, CapeSettings base = CapeSettings());
+CAPE_CORE_API CapeSettings applyFabric(const FabricMaterial& m, float spacing,
+                                       CapeSettings base = CapeSettings());
 /// Whether applyFabric(m, spacing) can be applied: the material's validate(), then the spacing (m, finite and
 /// > 0).
-Status checkFabric(const FabricMaterial& m, float spacing);
+CAPE_CORE_API Status checkFabric(const FabricMaterial& m, float spacing);
 
 /// The mass of a width x height piece of the fabric, kg (width and height in m; 0 for negative or non-finite
 /// sizes).
-float fabricMass(const FabricMaterial& m, float width, float height);
+CAPE_CORE_API float fabricMass(const FabricMaterial& m, float width, float height);
 
 /// The per-spring stiffness of one family for material `m` at grid spacing `spacing` (m), N/m: what
 /// applyFabric() puts into CapeSettings (exposed for tests and tools). Structural Y - G and shear G do not
-/// depend on the spacing; bend 8 B c^2 / h^4 (c the bending length) matches the skip-one spring's cubic
-/// moment law to the fabric's B at the curvature 1/c (docs/SOLVER.md, "Fabric presets").
+/// depend on the spacing (Y = stretchStiffness, G = shearStiffness).
 float fabricStructuralStiffness(const FabricMaterial& m, float spacing);
 float fabricShearStiffness(const FabricMaterial& m, float spacing);
+/// The stiffness a skip-one bend spring's hinge must have, N/m: 8 B c^2 / h^4 with c the bending length and h
+/// the spacing, which matches the spring's cubic moment law to the fabric's B at the curvature 1/c
+/// (docs/SOLVER.md, "Fabric presets").
+float fabricHingeStiffness(const FabricMaterial& m, float spacing);
+/// The bend spring's own stiffness, N/m: the hinge's, less the give of the two segments it spans, in series
+/// (1 / k = 1 / k_hinge - 2 / Y); infinite where the hinge must be stiffer than Y / 2, which a spring cannot
+/// give.
 float fabricBendStiffness(const FabricMaterial& m, float spacing);
 
 }  // namespace cape

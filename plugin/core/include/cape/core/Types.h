@@ -1,4 +1,5 @@
-// Basic types of the cape core: vectors, poses and the status value that reports bad input.
+/// \file
+/// Basic types of the cape core: vectors, poses and the status value that reports bad input.
 #pragma once
 
 #include "cape/core/Export.h"
@@ -16,7 +17,9 @@
 /// Lengths are metres, times seconds, masses kilograms, angles radians.
 namespace cape {
 
+/// A point or a vector of the core, float; a position in m, a velocity in m/s, ... (each use says which).
 using Vec3 = Eigen::Vector3f;
+/// A rotation of the core: a unit quaternion, float.
 using Quat = Eigen::Quaternionf;
 
 /// Particle data as structure of arrays: row i is particle i, column 0 holds every x, column 1 every y,
@@ -26,11 +29,14 @@ using Points = Eigen::Matrix<float, Eigen::Dynamic, 3>;
 
 /// A rigid transform: x_world = rotation * x_local + position. Units: metres.
 struct CAPE_CORE_API Pose {
-  Vec3 position = Vec3::Zero();
+  Vec3 position = Vec3::Zero();      ///< Where the local origin is, m.
   Quat rotation = Quat::Identity();  ///< Unit quaternion.
 
+  /// The world point of a local point, m: rotation * local + position.
   Vec3 apply(const Vec3& local) const { return rotation * local + position; }
+  /// The local point of a world point, m: the inverse of apply().
   Vec3 applyInverse(const Vec3& world) const { return rotation.conjugate() * (world - position); }
+  /// Whether every coordinate of the position and the rotation is finite.
   bool isFinite() const;
 
   /// Pose a fraction s in [0, 1] of the way from a to b: positions interpolated linearly, rotations along
@@ -41,10 +47,15 @@ struct CAPE_CORE_API Pose {
 /// The result of an operation that can fail on bad data: ok, or an error message meant for a person.
 class CAPE_CORE_API Status {
  public:
+  /// Success: ok() and an empty message.
   static Status success() { return Status(); }
+  /// An error with a message meant for a person (an empty message becomes "unknown error").
   static Status error(std::string message) { return Status(std::move(message)); }
+  /// True for success.
   bool ok() const { return message_.empty(); }
+  /// The same as ok().
   explicit operator bool() const { return ok(); }
+  /// What went wrong; empty on success.
   const std::string& message() const { return message_; }
 
  private:
@@ -55,6 +66,7 @@ class CAPE_CORE_API Status {
   std::string message_;
 };
 
+/// Whether every coordinate of `v` is finite.
 inline bool isFinite(const Vec3& v) {
   return v.allFinite();
 }

@@ -1,8 +1,9 @@
-// The simple body of docs/SCENES.md as kinematic Bullet rigid bodies: one per body collider of
-// cape::SimpleBody (torso box, shoulder spheres, leg capsules; not the ground plane, which a world has once
-// for every character), moved through their motion states so that Bullet derives their velocities. The Bullet
-// scene of the demos and the adapter's tests build the body with it, so both put the same bodies in the same
-// order.
+/// \file
+/// The simple body of docs/SCENES.md as kinematic Bullet rigid bodies: one per body collider of
+/// cape::SimpleBody (torso box, shoulder spheres, leg capsules; not the ground plane, which a world has once
+/// for every character), moved through their motion states so that Bullet derives their velocities. The
+/// Bullet scene of the demos and the adapter's tests build the body with it, so both put the same bodies in
+/// the same order.
 #pragma once
 
 #include "cape/scenes/BulletExport.h"
@@ -15,6 +16,7 @@
 
 namespace cape {
 
+/// The simple body as kinematic Bullet rigid bodies in a world it does not own (see BulletSimpleBody.h).
 class CAPE_SCENES_BULLET_API BulletSimpleBody {
  public:
   /// Places the simple body standing at `offset` in `pose` (teleported: no sweep) and adds one kinematic,
