@@ -66,15 +66,16 @@ CAPE_CORE_API float fabricMass(const FabricMaterial& m, float width, float heigh
 /// The per-spring stiffness of one family for material `m` at grid spacing `spacing` (m), N/m: what
 /// applyFabric() puts into CapeSettings (exposed for tests and tools). Structural Y - G and shear G do not
 /// depend on the spacing (Y = stretchStiffness, G = shearStiffness).
-float fabricStructuralStiffness(const FabricMaterial& m, float spacing);
-float fabricShearStiffness(const FabricMaterial& m, float spacing);
+CAPE_CORE_API float fabricStructuralStiffness(const FabricMaterial& m, float spacing);
+/// The shear family's per-spring stiffness, N/m (see fabricStructuralStiffness).
+CAPE_CORE_API float fabricShearStiffness(const FabricMaterial& m, float spacing);
 /// The stiffness a skip-one bend spring's hinge must have, N/m: 8 B c^2 / h^4 with c the bending length and h
 /// the spacing, which matches the spring's cubic moment law to the fabric's B at the curvature 1/c
 /// (docs/SOLVER.md, "Fabric presets").
-float fabricHingeStiffness(const FabricMaterial& m, float spacing);
+CAPE_CORE_API float fabricHingeStiffness(const FabricMaterial& m, float spacing);
 /// The bend spring's own stiffness, N/m: the hinge's, less the give of the two segments it spans, in series
 /// (1 / k = 1 / k_hinge - 2 / Y); infinite where the hinge must be stiffer than Y / 2, which a spring cannot
 /// give.
-float fabricBendStiffness(const FabricMaterial& m, float spacing);
+CAPE_CORE_API float fabricBendStiffness(const FabricMaterial& m, float spacing);
 
 }  // namespace cape
