@@ -1,6 +1,7 @@
 #include "cape/core/FabricPresets.h"
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace cape {
@@ -188,12 +189,24 @@ float fabricStructuralStiffness(const FabricMaterial& m, float spacing) {
 //    theta for the spring's strip of width h at theta = kappa h). The two can agree at one curvature only; we
 //    take the fabric's own, 1/c with c = (B / w)^(1/3) its bending length, the curvature its weight gives it
 //    over a bending length (a cantilever of the Peirce test droops with curvatures 0..2/c). Equal moments at
-//    kappa = 1/c give k = 8 B c^2 / h^4. For theta at that curvature the moment per width of the springs is
-//    the fabric's; the springs' law scales as kappa^3 c^2 B at every spacing, so two spacings bend alike.
-float fabricBendStiffness(const FabricMaterial& m, float spacing) {
+//    kappa = 1/c ask the hinge for k_hinge = 8 B c^2 / h^4; the springs' law is then B c^2 kappa^3 per width
+//    at every spacing, so two spacings bend alike. The hinge gives way through the bend spring and through
+//    the strip's two segments, which stretch as the bend spring pushes their ends apart (each with Y, the
+//    axial stiffness of one column of cells: structural plus diagonals); in series, 1 / k_hinge = 1 / k + 2 /
+//    Y, so k = 1 / (1 / k_hinge - 2 / Y). A hinge stiffer than Y / 2 cannot be had from a finite spring: k is
+//    then infinite (an inextensible bend spring), and the hinge only Y / 2 (fine grids of light, stiff
+//    fabrics: h^4 < 16 B c^2 / Y).
+float fabricHingeStiffness(const FabricMaterial& m, float spacing) {
   const double c = m.bendingLength();
   const double h = spacing;
   return static_cast<float>(8.0 * m.bendingRigidity * c * c / (h * h * h * h));
+}
+
+float fabricBendStiffness(const FabricMaterial& m, float spacing) {
+  const double hinge = fabricHingeStiffness(m, spacing);
+  const double rest = 1.0 / hinge - 2.0 / static_cast<double>(m.stretchStiffness);
+  if (!(rest > 0.0)) return std::numeric_limits<float>::infinity();
+  return static_cast<float>(1.0 / rest);
 }
 
 Status checkFabric(const FabricMaterial& m, float spacing) {
@@ -202,7 +215,7 @@ Status checkFabric(const FabricMaterial& m, float spacing) {
   if (!finitePositive(spacing))
     return Status::error("applyFabric: the grid spacing must be finite and > 0 m (got " +
                          std::to_string(spacing) + ")");
-  if (!std::isfinite(fabricBendStiffness(m, spacing)))
+  if (!std::isfinite(fabricHingeStiffness(m, spacing)))
     return Status::error("applyFabric: the grid spacing " + std::to_string(spacing) +
                          " m is too small for float bend stiffness");
   return Status::success();
