@@ -33,7 +33,8 @@ struct CAPE_CORE_API FabricMaterial {
   /// weight per area under standard gravity g = 9.80665 m/s^2.
   float bendingLength() const;
   /// Whether every number is finite and in range (name not empty; density, stretch and bending > 0; shear,
-  /// damping, drag >= 0; lift finite): a clear message otherwise.
+  /// damping, drag >= 0; shear below stretch, since the grid's diagonals carry both; lift finite): a clear
+  /// message otherwise.
   Status validate() const;
 };
 
