@@ -127,7 +127,8 @@ TEST(CoreCollision, AMeshFloorHoldsACapeDroppedAt10MetresPerSecond) {
 TEST(CoreCollision, AHeightfieldHoldsACapeDroppedAt10MetresPerSecond) {
   static float heights[9 * 9];
   for (int i = 0; i < 81; ++i) heights[i] = 0.0f;
-  auto* terrain = new btHeightfieldTerrainShape(9, 9, heights, 1.0f, -1.0f, 1.0f, 1, PHY_FLOAT, false);
+  auto* terrain =
+      new btHeightfieldTerrainShape(9, 9, static_cast<const float*>(heights), -1.0f, 1.0f, 1, false);
   terrain->setLocalScaling(btVector3(0.5f, 1.0f, 0.5f));
   const btScalar margin = terrain->getMargin();  // the world dropOn makes owns the shape, and deletes it
   const Landing r = dropOn(terrain, btTransform::getIdentity(), btScalar(0.5));

@@ -644,12 +644,68 @@ void CapeAction::advance(btScalar dt) {
 
 void CapeAction::debugDraw(btIDebugDraw* drawer) {
   if (drawer == nullptr || !ok()) return;
+  const int mode = drawer->getDebugMode();
+  const CapeState& state = cape_.state();
+  const Eigen::Vector3d& origin = cape_.origin();
+  // Everything is computed in the cape's frame (where the particles and colliders are precise) and drawn in
+  // the world's.
+  const auto world = [&origin](const Vec3& p) {
+    const Eigen::Vector3d x = p.cast<double>() + origin;
+    return btVector3(btScalar(x.x()), btScalar(x.y()), btScalar(x.z()));
+  };
+  const auto direction = [](const Vec3& v) {
+    return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z()));
+  };
+  // The faces, filled (drawTriangle with the face's normal at its three corners: the counter-clockwise side
+  // is the front); their edges with DBG_DrawWireframe, their normals (5 cm) with DBG_DrawNormals.
+  const btVector3 edgeColor = debugColor_ * btScalar(0.5);
+  const btVector3 normalColor = drawer->getDefaultColors().m_activeObject;
   const std::vector<std::uint32_t>& tri = cape_.fabric().triangles();
   for (std::size_t k = 0; k + 2 < tri.size(); k += 3) {
-    const btVector3 a = position(tri[k]), b = position(tri[k + 1]), c = position(tri[k + 2]);
-    drawer->drawLine(a, b, debugColor_);
-    drawer->drawLine(b, c, debugColor_);
-    drawer->drawLine(c, a, debugColor_);
+    const Vec3 pa = state.positions.row(tri[k]).transpose(), pb = state.positions.row(tri[k + 1]).transpose(),
+               pc = state.positions.row(tri[k + 2]).transpose();
+    const Vec3 cross = (pb - pa).cross(pc - pa);
+    const float length = cross.norm();
+    const Vec3 n = length > 0.0f && std::isfinite(length) ? Vec3(cross / length) : Vec3::Zero();
+    const btVector3 a = world(pa), b = world(pb), c = world(pc), bn = direction(n);
+    drawer->drawTriangle(a, b, c, bn, bn, bn, debugColor_, btScalar(1));
+    if (mode & btIDebugDraw::DBG_DrawWireframe) {
+      drawer->drawLine(a, b, edgeColor);
+      drawer->drawLine(b, c, edgeColor);
+      drawer->drawLine(c, a, edgeColor);
+    }
+    if (mode & btIDebugDraw::DBG_DrawNormals) {
+      const Vec3 centre = (pa + pb + pc) / 3.0f;
+      drawer->drawLine(world(centre), world(centre + 0.05f * n), normalColor);
+    }
+  }
+  // The pins: a 1 cm sphere at each pin's target, in the colour of Bullet's constraints.
+  const btVector3 pinColor = drawer->getDefaultColors().m_disabledSimulationObject;
+  for (const Pin& pin : state.pins) drawer->drawSphere(world(pin.target), btScalar(0.01), pinColor);
+  // The contacts, when the drawer asks for contact points: each particle within the cape's thickness (and
+  // the collider's) of a collider of the last step, at the collider's nearest surface point, with the
+  // normal towards the particle and the signed distance (negative: inside), as Bullet draws its own.
+  if (mode & btIDebugDraw::DBG_DrawContactPoints) {
+    const float reach = cape_.settings().collisionThickness;
+    const btVector3 contactColor = drawer->getDefaultColors().m_contactPoint;
+    for (const Collider& collider : colliders_) {
+      const float within = reach + collider.thickness + 1e-3f;
+      for (Eigen::Index i = 0; i < state.positions.rows(); ++i) {
+        const Vec3 p = state.positions.row(i).transpose();
+        const float d = signedDistance(collider, p);
+        if (!(d < within)) continue;
+        const Vec3 q = closestSurfacePoint(collider, p);
+        const Vec3 towards = p - q;
+        const float length = towards.norm();
+        const Vec3 n = length > 0.0f && std::isfinite(length) ? Vec3(towards / length) : Vec3::UnitY();
+        drawer->drawContactPoint(world(q), direction(d < 0.0f ? Vec3(-n) : n), btScalar(d), 0, contactColor);
+      }
+    }
+  }
+  if (mode & btIDebugDraw::DBG_DrawAabb) {
+    const Vec3 lo = state.positions.colwise().minCoeff().transpose();
+    const Vec3 hi = state.positions.colwise().maxCoeff().transpose();
+    drawer->drawAabb(world(lo), world(hi), drawer->getDefaultColors().m_aabb);
   }
 }
 

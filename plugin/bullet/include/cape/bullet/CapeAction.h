@@ -174,9 +174,15 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   // --- Stepping ----------------------------------------------------------------------------------------
   /// One internal step of the world (dt s): prepare() then advance().
   void updateAction(btCollisionWorld* world, btScalar dt) override;
-  /// Draws every triangle's edges (m, world) in the colour given.
+  /// Draws the cape as Bullet's debug drawers expect (world coordinates, m), by the drawer's debug mode:
+  /// always every triangle filled (drawTriangle, with its face normal at the corners, in the colour of
+  /// setDebugColor) and each pin's target as a 1 cm sphere; with DBG_DrawWireframe the triangles' edges, with
+  /// DBG_DrawNormals the face normals (5 cm), with DBG_DrawContactPoints every particle within the
+  /// thicknesses of a collider of the last step (drawContactPoint at the collider's nearest surface point,
+  /// outward normal, signed distance), with DBG_DrawAabb the cape's bounds. A world calls it from
+  /// debugDrawWorld() when the mode has DBG_DrawWireframe, DBG_DrawAabb or DBG_DrawNormals.
   void debugDraw(btIDebugDraw* drawer) override;
-  /// The colour debugDraw() uses (RGB, 0..1).
+  /// The faces' colour in debugDraw (red, green, blue in 0..1); the edges are drawn at half of it.
   void setDebugColor(const btVector3& color) { debugColor_ = color; }
 
   /// The two halves of updateAction, for CapeGroup: prepare() reads the world (bodies still present,
