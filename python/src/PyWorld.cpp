@@ -538,7 +538,11 @@ int World::addCapeOnCharacter(const CapeSpec& spec, int character) {
   char line[128];
   std::snprintf(line, sizeof line, "; a %.2f x %.2f m cape, its top %.0f cm behind the shoulders", width,
                 height, 100.0 * (a.back + kBehind));
-  return addCape(rig, spec, toBt(placement), pins, torso, a.description + line);
+  std::string description = a.description + line;
+  if (layout == cape::PinLayout::Collar)
+    description += "; its top row pinned to the upper torso '" +
+                   c.skeleton().model().links()[static_cast<std::size_t>(a.upperTorsoLink)].name + "'";
+  return addCape(rig, spec, toBt(placement), pins, torso, std::move(description));
 }
 
 int World::capeCount() const {

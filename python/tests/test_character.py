@@ -92,6 +92,7 @@ def test_a_urdf_file_in_a_z_up_world_with_its_gait():
     world = capecloth.World(up="z")
     human = world.load_urdf(str(REPO / "character" / "models" / "humanoid.urdf"), gait="walk")
     cape = human.attach_cape(pins="collar")
+    assert "upper torso 'torso'" in cape.description
     for f in range(1, 121):
         human.advance_to(f / 60)
         world.step()

@@ -25,7 +25,7 @@ def test_a_python_thread_runs_while_step_runs():
     thread.start()
     time.sleep(0.02)
     begin = time.perf_counter()
-    world.step(frames=40)
+    world.step(frames=80)
     end = time.perf_counter()
     stop.set()
     thread.join()
@@ -36,6 +36,6 @@ def test_a_python_thread_runs_while_step_runs():
     assert step_time > 0.1, "the step is too short to tell"
     # Held, the GIL would leave the thread one gap as long as the whole step.
     assert max(gaps) < 0.25 * step_time
-    assert len(during) > 0.2 * step_time / 0.0011
+    assert len(during) > 0.1 * step_time / 0.0011
     after = cape.metrics()
     assert not after["blow_up"]
