@@ -101,3 +101,29 @@ def test_a_urdf_file_in_a_z_up_world_with_its_gait():
     assert x[:, 2].max() < 1.8 and x[:, 2].min() > 0.2  # hangs along z, above the ground
     assert x.mean(axis=0)[0] > 1.4 * 2.0 - 0.5  # a Z-up character faces +X and walked 2 s
     assert cape.summary()["max_strain"] < 0.3
+
+
+def test_package_paths_find_a_urdf_mesh(tmp_path):
+    pkg = tmp_path / "share" / "my_robot"
+    pkg.mkdir(parents=True)
+    corners = [(x, y, z) for x in (-0.1, 0.1) for y in (-0.1, 0.1) for z in (0.0, 0.3)]
+    faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2),
+             (3, 4, 8), (3, 8, 7), (1, 3, 7), (1, 7, 5), (2, 6, 8), (2, 8, 4)]
+    (pkg / "block.obj").write_text("".join(f"v {x} {y} {z}\n" for x, y, z in corners) +
+                                   "".join(f"f {a} {b} {c}\n" for a, b, c in faces))
+    urdf = tmp_path / "robot.urdf"
+    urdf.write_text("""<?xml version="1.0"?>
+<robot name="blockbot">
+  <link name="base"><collision><geometry><mesh filename="package://my_robot/block.obj"/></geometry></collision></link>
+</robot>""")
+    # Without the package path the mesh is left out, and the warning says why.
+    world = capecloth.World()
+    alone = world.load_urdf(str(urdf))
+    assert any("not found" in w and "package" in w for w in alone.warnings)
+    assert world.colliders()["shape"] == []
+    world = capecloth.World()
+    robot = world.load_urdf(str(urdf), package_paths=[str(tmp_path / "share")])
+    assert robot.link_names == ["base"]
+    cols = world.colliders()
+    assert cols["shape"] == ["convex_hull"] and cols["owner"] == ["blockbot0/base"]
+    assert cols["radius"][0] == pytest.approx(np.linalg.norm([0.1, 0.1, 0.3]), abs=0.02)
