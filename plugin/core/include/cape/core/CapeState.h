@@ -14,13 +14,14 @@ namespace cape {
 /// Within a step the target moves from `previousTarget` (start of the step) to `target` (end of the step).
 struct Pin {
   std::uint32_t particle = 0;          ///< The pinned particle's index.
-  Vec3 previousTarget = Vec3::Zero();  ///< m, world.
-  Vec3 target = Vec3::Zero();          ///< m, world.
+  Vec3 previousTarget = Vec3::Zero();  ///< m, in the cape's frame (see CapeState).
+  Vec3 target = Vec3::Zero();          ///< m, in the cape's frame (see CapeState).
 };
 
-/// The per-cape runtime state, one row (or entry) per particle, in the cape's frame (Cape::origin).
+/// The per-cape runtime state, one row (or entry) per particle. Positions and pin targets are in the cape's
+/// frame: relative to the world point Cape::origin(), so world coordinates while that is zero (the default).
 struct CapeState {
-  Points positions;               ///< m, world.
+  Points positions;               ///< m, in the cape's frame.
   Points velocities;              ///< m/s.
   Eigen::VectorXf inverseMasses;  ///< 1/kg; 0 locks the particle (pins).
   std::vector<Pin> pins;          ///< At most one pin per particle.
