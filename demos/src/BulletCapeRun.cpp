@@ -112,6 +112,7 @@ class BulletCapeRun final : public SceneRun {
   std::string describe() const override { return scene_->describe(); }
   Vec3 up() const override { return scene_->up(); }
   CapeSize capeSize() const override { return scene_->capeSize(); }
+  const CapeSettings& settings() const override { return scene_->settings(); }
 
  private:
   std::unique_ptr<BulletScene> scene_;
@@ -133,7 +134,7 @@ std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& e
   if (!scene) return nullptr;
   for (const std::string& n : scene->notes()) std::printf("cape_walk: %s\n", n.c_str());
   auto run = std::make_unique<BulletCapeRun>(std::move(scene), options.threads);
-  if (!run->build(options.settings, options.scene, error)) return nullptr;
+  if (!run->build(run->settings(), options.scene, error)) return nullptr;
   return run;
 }
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 namespace cape::demo {
 
@@ -55,6 +56,70 @@ std::shared_ptr<const ConvexHull> hullOf(const character::ShapeDesc& shape) {
 }
 
 }  // namespace
+
+int squareCellRows(int columns, double width, double height) {
+  return std::max(2, static_cast<int>(std::lround(static_cast<double>(columns - 1) * height / width)) + 1);
+}
+
+bool BulletScene::makeRig(const CapeSize& fitted, std::string& error) {
+  const RunOptions& o = options_;
+  settings_ = o.settings;
+  const bool bend = o.settings.bendStiffness > 0.0f;
+  if (!o.capeWidth && !o.capeHeight && !o.fabric) {
+    capeSize_ = fitted;
+    rig_ = makeCapeRig(o.size, o.pinLayout, bend, fitted);
+  } else {
+    // The pins and the canonical mass per area as makeCapeRig gives them for this size (or the fabric's
+    // mass), on a grid of `size` particles across and, with a width or a height, as many rows as keep the
+    // cells square.
+    capeSize_.width = o.capeWidth.value_or(fitted.width);
+    capeSize_.height = o.capeHeight.value_or(fitted.height);
+    const int rows =
+        o.capeWidth || o.capeHeight ? squareCellRows(o.size, capeSize_.width, capeSize_.height) : o.size;
+    if (rows > kMaxGridSide) {
+      char line[256];
+      std::snprintf(line, sizeof line,
+                    "a %.3g x %.3g m cape %d particles across needs %d rows for square cells, more than %d: "
+                    "give a smaller --size or a wider or shorter cape",
+                    capeSize_.width, capeSize_.height, o.size, rows, kMaxGridSide);
+      error = line;
+      return false;
+    }
+    rig_ = makeCapeRig(o.size, o.pinLayout, bend, capeSize_);
+    if (rig_.fabric && (rows != o.size || o.fabric)) {
+      GridDesc g;
+      g.columns = o.size;
+      g.rows = rows;
+      g.width = capeSize_.width;
+      g.height = capeSize_.height;
+      g.totalMass =
+          o.fabric ? fabricMass(*o.fabric, capeSize_.width, capeSize_.height) : rig_.fabric->totalMass();
+      g.bendSprings = bend;
+      g.tetherAnchors = rig_.pinnedParticles;
+      FabricResult made = Fabric::grid(g);
+      if (!made) {
+        error = "cannot build the cape: " + made.status.message();
+        return false;
+      }
+      rig_.fabric = made.fabric;
+    }
+  }
+  if (!rig_.fabric) {
+    error = "cannot build a " + std::to_string(o.size) + " particle wide cape";
+    return false;
+  }
+  if (o.fabric) {
+    // The springs for this grid's spacing (the mean of its structural springs' rest lengths).
+    const float spacing = rig_.fabric->meanSpacing();
+    if (const Status s = checkFabric(*o.fabric, spacing); !s.ok()) {
+      error = "--fabric " + o.fabric->name + ": " + s.message();
+      return false;
+    }
+    // The scene's wind first, so that the fabric's drag and lift apply to it.
+    settings_ = applyFabric(*o.fabric, spacing, settingsForScene(o.scene, o.settings));
+  }
+  return true;
+}
 
 /// One character: its bodies (from the character library, or the simple body's five), and its cape's pins.
 /// Each removes its bodies from the world when destroyed.
@@ -107,17 +172,13 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
   const int count = o.scene == SceneKind::Crowd ? std::max(1, o.characters) : 1;
   if (o.simpleBody) {
     body_ = "the simple body of docs/SCENES.md as kinematic Bullet bodies";
-    rig_ = makeCapeRig(o.size, o.pinLayout, o.settings.bendStiffness > 0.0f);
+    if (!makeRig(CapeSize(), error)) return false;
     for (int k = 0; k < count; ++k) addSimpleCharacter(crowdOffset(k, count));
     if (!o.attachLinks.empty()) warnings_.push_back("--attach is ignored with --simple-body");
   } else {
     if (!loadModel(o, error)) return false;
     for (int k = 0; k < count; ++k)
       if (!addUrdfCharacter(crowdOffset(k, count), k == 0, error)) return false;
-  }
-  if (!rig_.fabric) {
-    error = "cannot build a " + std::to_string(o.size) + " x " + std::to_string(o.size) + " cape";
-    return false;
   }
   for (auto& c : characters_) placeCape(*c);
   return true;
@@ -332,8 +393,8 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
     size.width = static_cast<float>(std::round(std::clamp(span + 2.0 * 0.08, 0.2, 3.0) * 1000.0) / 1000.0);
     const double pinHeight = 0.5 * (a.left.y() + a.right.y()) + kPinLineAbove;
     size.height = static_cast<float>(std::round(std::clamp(pinHeight - 0.45, 0.2, 1.0) * 1000.0) / 1000.0);
-    capeSize_ = size;
-    rig_ = makeCapeRig(options_.size, options_.pinLayout, options_.settings.bendStiffness > 0.0f, size);
+    if (!makeRig(size, error)) return false;
+    size = capeSize_;
     attachDescription_ = a.description;
     char line[160];
     std::snprintf(line, sizeof line, "; a %.2f x %.2f m cape, its top %.0f cm behind the shoulders",

@@ -89,6 +89,8 @@ class BulletScene {
   const Eigen::Matrix3f& sceneToWorld() const { return toWorld_; }
   /// The cape's size (canonical, or fitted to the character's shoulders).
   const CapeSize& capeSize() const { return capeSize_; }
+  /// The options' cape settings with the fabric preset applied (RunOptions::fabric), if any.
+  const CapeSettings& settings() const { return settings_; }
 
  private:
   struct Character;
@@ -99,6 +101,9 @@ class BulletScene {
   void addSimpleCharacter(const Vec3& offset);
   bool addUrdfCharacter(const Vec3& offset, bool first, std::string& error);
   void placeCape(Character& c);
+  /// The cape's rig and size: `fitted` (the canonical size, or the one fitted to the character) unless the
+  /// options give a width or a height. False and the reason when no such cape can be built.
+  bool makeRig(const CapeSize& fitted, std::string& error);
   Vec3 toWorld(const Vec3& scene) const;
   void poseAt(double t);
 
@@ -122,6 +127,7 @@ class BulletScene {
   std::unique_ptr<character::MotionPlayer> player_;  ///< bound to model_ by the first character
   double motionUs_ = 0.0;                            ///< stepFrame's poseAt, µs
   CapeSize capeSize_;
+  CapeSettings settings_;
   CapeRig rig_;
   std::vector<std::unique_ptr<Character>> characters_;
   std::vector<std::string> attachLinks_;

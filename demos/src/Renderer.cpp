@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <csetjmp>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 
@@ -417,24 +418,19 @@ void RunRenderer::record(int character, const CapeMesh& mesh, const std::vector<
   if (character == characters_ - 1) renderFrame();
 }
 
-void RunRenderer::follow(View& view, const std::vector<const Pending*>& characters, int x, int width) {
-  // Where the characters are: the mean of their colliders' centres (the cape's, without colliders).
-  std::vector<Vec3> centres;
-  for (const Pending* p : characters) {
-    if (!p->cape && !p->mesh) continue;
-    Vec3 c = Vec3::Zero();
-    int count = 0;
-    for (const Collider& col : p->colliders) {
-      if (col.shape == ColliderShape::Plane) continue;
-      c += col.current.position;
-      ++count;
-    }
-    if (count == 0) {
-      c = (p->cape ? p->cape->state().positions : p->mesh->positions).colwise().mean().transpose();
-      count = 1;
-    }
-    centres.push_back(c / static_cast<float>(count));
+Vec3 characterCentre(const Points& capePositions, const std::vector<Collider>& colliders) {
+  Vec3 c = Vec3::Zero();
+  int count = 0;
+  for (const Collider& col : colliders) {
+    if (col.shape == ColliderShape::Plane) continue;
+    c += col.current.position;
+    ++count;
   }
+  if (count > 0) return c / static_cast<float>(count);
+  return capePositions.rows() > 0 ? Vec3(capePositions.colwise().mean().transpose()) : Vec3::Zero();
+}
+
+void FollowCamera::follow(const std::vector<Vec3>& centres, int x, int width, int height) {
   Vec3 centre = Vec3::Zero();
   for (const Vec3& c : centres) centre += c;
   centre /= static_cast<float>(std::max<std::size_t>(centres.size(), 1));
@@ -443,25 +439,41 @@ void RunRenderer::follow(View& view, const std::vector<const Pending*>& characte
 
   // Turn with the heading of the motion (kept while standing), smoothed over about 0.35 s.
   const float dt = 1.0f / 60.0f, kTwoPi = 6.28318530718f;
-  if (view.started) {
-    const Vec3 v = (centre - view.lastCentre) / dt;
+  if (started_) {
+    const Vec3 v = (centre - centre_) / dt;
     if (std::hypot(v.x(), v.z()) > 0.5f) {
       const float target = std::atan2(-v.x(), -v.z());
-      const float delta = std::remainder(target - view.heading, kTwoPi);
-      view.heading = std::remainder(view.heading + delta * (1.0f - std::exp(-dt / 0.35f)), kTwoPi);
+      const float delta = std::remainder(target - heading_, kTwoPi);
+      heading_ = std::remainder(heading_ + delta * (1.0f - std::exp(-dt / 0.35f)), kTwoPi);
     }
   }
-  view.started = true;
-  view.lastCentre = centre;
-  const Vec3 forward(-std::sin(view.heading), 0.0f, -std::cos(view.heading));
-  const Vec3 left(-std::cos(view.heading), 0.0f, std::sin(view.heading));
-  const Vec3 target(centre.x(), 1.0f, centre.z());
-  // Behind and to the left, a little above the torso; farther back for a wide crowd or a narrow panel.
-  const float aspect = static_cast<float>(width) / static_cast<float>(renderer_->height());
-  const float back = (2.8f + 1.2f * spread) * std::max(1.0f, 1.6f / aspect);
-  const Vec3 eye = target - back * forward + (1.5f + 0.6f * spread) * left + Vec3(0, 0.6f, 0);
-  view.camera = Camera::lookAt(eye, target, width, renderer_->height(), 40.0f);
-  view.camera.x = x;
+  started_ = true;
+  centre_ = centre;
+  const Vec3 forward(-std::sin(heading_), 0.0f, -std::cos(heading_));
+  const Vec3 left(-std::cos(heading_), 0.0f, std::sin(heading_));
+  target_ = Vec3(centre.x(), 1.0f, centre.z());
+  // Farther back for a wide group or a narrow panel.
+  const Framing& f = framing_;
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  const float back = (f.back + f.backPerSpread * spread) * std::max(1.0f, 1.6f / aspect);
+  eye_ = target_ - back * forward + (f.side + f.sidePerSpread * spread) * left + Vec3(0, f.rise, 0);
+  camera_ = Camera::lookAt(eye_, target_, width, height, f.fovYDegrees);
+  camera_.x = x;
+}
+
+Camera FollowCamera::cameraFor(int width, int height) const {
+  return Camera::lookAt(eye_, target_, width, height, framing_.fovYDegrees);
+}
+
+void RunRenderer::follow(FollowCamera& view, const std::vector<const Pending*>& characters, int x,
+                         int width) {
+  std::vector<Vec3> centres;
+  for (const Pending* p : characters) {
+    if (!p->cape && !p->mesh) continue;
+    centres.push_back(
+        characterCentre(p->cape ? p->cape->state().positions : p->mesh->positions, p->colliders));
+  }
+  view.follow(centres, x, width, renderer_->height());
 }
 
 void RunRenderer::renderFrame() {
@@ -470,8 +482,8 @@ void RunRenderer::renderFrame() {
   for (const Pending& p : pending_) all.push_back(&p);
   if (layout_ == Layout::Together) {
     follow(views_[0], all, 0, renderer_->width());
-    renderer_->begin(views_[0].camera);
-    renderer_->drawGround(views_[0].lastCentre, 40.0f);
+    renderer_->begin(views_[0].camera());
+    renderer_->drawGround(views_[0].centre(), 40.0f);
     for (const Pending* p : all) {
       renderer_->drawColliders(p->colliders);
       if (p->cape) renderer_->drawCape(*p->cape);
@@ -482,11 +494,11 @@ void RunRenderer::renderFrame() {
     const int panels = static_cast<int>(views_.size()), gap = 2;
     const int width = (renderer_->width() - gap * (panels - 1)) / panels;
     for (int k = 0; k < panels; ++k) {
-      View& view = views_[static_cast<std::size_t>(k)];
+      FollowCamera& view = views_[static_cast<std::size_t>(k)];
       const Pending* p = all[static_cast<std::size_t>(k)];
       follow(view, {p}, k * (width + gap), width);
-      renderer_->begin(view.camera);
-      renderer_->drawGround(view.lastCentre, 40.0f);
+      renderer_->begin(view.camera());
+      renderer_->drawGround(view.centre(), 40.0f);
       renderer_->drawColliders(p->colliders);
       if (p->cape) renderer_->drawCape(*p->cape);
       if (p->mesh) renderer_->drawCape(*p->mesh);
@@ -533,6 +545,147 @@ bool RunRenderer::finish(std::string& error) {
     return false;
   }
   return true;
+}
+
+// --- RunMovie ---------------------------------------------------------------------------------------------
+
+namespace {
+
+/// The area the cape's front triangles cover in the camera's image, px^2 (overlaps counted twice).
+double projectedArea(const CapeMesh& mesh, const Camera& camera) {
+  const std::size_t front = mesh.twoSided() ? mesh.indices.size() / 2 : mesh.indices.size();
+  double area = 0.0;
+  for (std::size_t t = 0; t + 2 < front; t += 3) {
+    Eigen::Vector2f p[3];
+    bool seen = true;
+    for (int i = 0; i < 3 && seen; ++i)
+      seen =
+          camera.project(mesh.positions.row(mesh.indices[t + static_cast<std::size_t>(i)]).transpose(), p[i]);
+    if (!seen) continue;
+    const Eigen::Vector2f a = p[1] - p[0], b = p[2] - p[0];
+    area += 0.5 * std::fabs(static_cast<double>(a.x()) * b.y() - static_cast<double>(a.y()) * b.x());
+  }
+  return area;
+}
+
+}  // namespace
+
+RunMovie::RunMovie(const fs::path& picture, const fs::path& video, int characters, const Settings& settings)
+    : picture_(picture),
+      video_(video),
+      settings_(settings),
+      characters_(std::max(characters, 1)),
+      camera_(FollowCamera::threeQuarter()),
+      meshes_(static_cast<std::size_t>(characters_), nullptr),
+      colliders_(static_cast<std::size_t>(characters_)) {
+  const int fps = std::clamp(settings.framesPerSecond, 1, 60);
+  step_ = 60 / fps;
+  windowFrames_ = std::min<std::int64_t>(settings.runFrames, std::llround(settings.seconds * 60.0));
+  // The picture from the second second on, when the video is that long (the cape has left its flat start).
+  pictureFrom_ = windowFrames_ >= 120 ? 60 : std::max<std::int64_t>(1, windowFrames_ / 2);
+  best_.camera = camera_;
+  renderer_ =
+      std::make_unique<Renderer>(settings.videoWidth, settings.videoHeight, settings.videoSupersample);
+  if (!renderer_->ok()) {
+    error_ = renderer_->error();
+    return;
+  }
+  if (settings.videoWidth % 2 != 0 || settings.videoHeight % 2 != 0) {
+    error_ = "the video's sides must be even";
+    return;
+  }
+  if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0) return;  // no video: writesVideo() says so
+  std::signal(SIGPIPE, SIG_IGN);
+  const std::string command = "ffmpeg -y -loglevel error -f rawvideo -pix_fmt rgba -s " +
+                              std::to_string(settings.videoWidth) + "x" +
+                              std::to_string(settings.videoHeight) + " -framerate " + std::to_string(fps) +
+                              " -i - -c:v libx264 -preset superfast -crf 27 -pix_fmt yuv420p -threads 1 "
+                              "-movflags +faststart " +
+                              shellQuote(video.string());
+  pipe_ = popen(command.c_str(), "w");
+  if (!pipe_) error_ = "cannot start ffmpeg for " + video.string();
+}
+
+RunMovie::~RunMovie() {
+  if (pipe_) pclose(pipe_);
+}
+
+void RunMovie::draw(Renderer& renderer, const Camera& camera, const std::vector<const CapeMesh*>& meshes,
+                    const std::vector<std::vector<Collider>>& colliders, const Vec3& centre) {
+  renderer.begin(camera);
+  renderer.drawGround(centre, 40.0f);
+  for (std::size_t k = 0; k < meshes.size(); ++k) {
+    renderer.drawColliders(colliders[k]);
+    if (meshes[k]) renderer.drawCape(*meshes[k]);
+  }
+}
+
+void RunMovie::record(std::int64_t frame, int character, const CapeMesh& mesh,
+                      const std::vector<Collider>& colliders) {
+  if (!ok() || !wants(frame) || character < 0 || character >= characters_) return;
+  const auto k = static_cast<std::size_t>(character);
+  meshes_[k] = &mesh;
+  colliders_[k] = colliders;
+  if (character != characters_ - 1) return;
+
+  // Every frame moves the camera on (it smooths over frames); every step_-th is drawn, and the last.
+  std::vector<Vec3> centres;
+  for (std::size_t c = 0; c < meshes_.size(); ++c)
+    if (meshes_[c]) centres.push_back(characterCentre(meshes_[c]->positions, colliders_[c]));
+  camera_.follow(centres, 0, renderer_->width(), renderer_->height());
+  if (frame % step_ != 0 && frame != windowFrames_) return;
+
+  const auto start = std::chrono::steady_clock::now();
+  {
+    // Before pictureFrom_ the latest frame is kept (the picture of a run that ends early); from then on the
+    // one that shows the most cape.
+    double score = 0.0;
+    if (frame >= pictureFrom_)
+      for (const CapeMesh* m : meshes_)
+        if (m) score += projectedArea(*m, camera_.camera());
+    if (frame < pictureFrom_ || best_.frame < pictureFrom_ || score > best_.score) {
+      best_.frame = frame;
+      best_.score = score;
+      best_.camera = camera_;
+      best_.colliders = colliders_;
+      best_.meshes.clear();
+      for (const CapeMesh* m : meshes_) best_.meshes.push_back(m ? *m : CapeMesh());
+    }
+  }
+  if (pipe_) {
+    draw(*renderer_, camera_.camera(), meshes_, colliders_, camera_.centre());
+    const Image& image = renderer_->finish();
+    if (std::fwrite(image.rgba.data(), 1, image.rgba.size(), pipe_) != image.rgba.size()) {
+      error_ = "ffmpeg stopped taking the frames of " + video_.string();
+      pclose(pipe_);
+      pipe_ = nullptr;
+    }
+    ++videoFrames_;
+  }
+  renderMs_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+bool RunMovie::finish(std::string& error) {
+  if (pipe_) {
+    const int status = pclose(pipe_);
+    pipe_ = nullptr;
+    if (status != 0 && ok()) error_ = "ffmpeg could not write " + video_.string();
+  }
+  if (ok() && best_.frame == 0) error_ = "no frame recorded for " + picture_.string();
+  if (!ok()) {
+    error = error_;
+    return false;
+  }
+  Renderer still(settings_.pictureWidth, settings_.pictureHeight, settings_.pictureSupersample);
+  if (!still.ok()) {
+    error = still.error();
+    return false;
+  }
+  std::vector<const CapeMesh*> meshes;
+  for (const CapeMesh& m : best_.meshes) meshes.push_back(m.positions.rows() > 0 ? &m : nullptr);
+  draw(still, best_.camera.cameraFor(still.width(), still.height()), meshes, best_.colliders,
+       best_.camera.centre());
+  return writePng(picture_, still.finish(), error, 6);
 }
 
 }  // namespace cape::demo

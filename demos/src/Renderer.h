@@ -8,6 +8,7 @@
 #include "cape/core/CapeMesh.h"
 
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -106,6 +107,49 @@ class Renderer {
   std::map<std::string, GpuMesh> shapes_;  ///< Collider meshes by shape and size.
 };
 
+/// Where a FollowCamera's eye sits relative to the point it looks at (1 m above the characters' centre) for
+/// characters together at their centre; a group whose farthest character is `spread` m from the centre
+/// moves it out by the per-spread terms.
+struct CameraFraming {
+  float back = 2.8f;           ///< behind the characters, m
+  float backPerSpread = 1.2f;  ///< m per m of spread
+  float side = 1.5f;           ///< to their left, m
+  float sidePerSpread = 0.6f;  ///< m per m of spread
+  float rise = 0.6f;           ///< above the point looked at, m
+  float fovYDegrees = 40.0f;   ///< vertical field of view, degrees
+};
+
+/// A camera that follows characters as they move: it looks at a point 1 m above their centre from behind
+/// them and to their left, turning with their heading (smoothed over about 0.35 s, kept while they stand).
+class FollowCamera {
+ public:
+  using Framing = CameraFraming;
+  /// Behind and to the left at 45 degrees, a little higher: the three-quarter view of a run's picture.
+  static Framing threeQuarter() { return Framing{2.4f, 1.0f, 2.4f, 1.0f, 0.8f, 40.0f}; }
+
+  explicit FollowCamera(const Framing& framing = Framing()) : framing_(framing) {}
+  /// Moves on to this frame's character centres (m; one frame of 1/60 s after the last call) and aims at
+  /// them in a panel `width` x `height` px whose left edge is `x` px from the image's.
+  void follow(const std::vector<Vec3>& centres, int x, int width, int height);
+  /// The camera of the last follow().
+  const Camera& camera() const { return camera_; }
+  /// The same eye and target in an image of another size.
+  Camera cameraFor(int width, int height) const;
+  /// The characters' centre at the last follow(), m.
+  const Vec3& centre() const { return centre_; }
+
+ private:
+  Framing framing_;
+  Camera camera_;
+  Vec3 centre_ = Vec3::Zero(), eye_ = Vec3::Zero(), target_ = Vec3::Zero();
+  float heading_ = 0.0f;  ///< rad about +Y; 0 faces -Z
+  bool started_ = false;
+};
+
+/// Where a character is, for a following camera: the mean of its body colliders' centres (planes left out),
+/// or of the cape's vertices when it has none.
+Vec3 characterCentre(const Points& capePositions, const std::vector<Collider>& colliders);
+
 /// Renders a run frame by frame into a folder: DIR/00001.png, ... and, with ffmpeg on PATH, DIR/run.mp4
 /// (H.264, 60 fps) and DIR/run.gif (every third frame, 320 px wide, 64 colours). The camera follows the
 /// characters from behind and to their left, looking at the torso, turning with their heading.
@@ -133,7 +177,7 @@ class RunRenderer {
   /// Mean wall time per frame of drawing and reading back (PNG writing excluded), ms.
   double meanRenderMs() const { return frame_ > 0 ? renderMs_ / frame_ : 0.0; }
   /// The camera of a panel (0 with Together) in the last frame, and the last frame itself.
-  const Camera& camera(int panel = 0) const { return views_.at(static_cast<std::size_t>(panel)).camera; }
+  const Camera& camera(int panel = 0) const { return views_.at(static_cast<std::size_t>(panel)).camera(); }
   const Image& lastImage() const { return renderer_->image(); }
 
  private:
@@ -149,17 +193,76 @@ class RunRenderer {
     std::vector<Collider> colliders;
   };
   std::vector<Pending> pending_;
-  /// A following camera: where its characters were and the heading it turned to.
-  struct View {
-    Camera camera;
-    Vec3 lastCentre = Vec3::Zero();
-    float heading = 0.0f;  ///< rad about +Y; 0 faces -Z
-    bool started = false;
-  };
-  void follow(View& view, const std::vector<const Pending*>& characters, int x, int width);
+  void follow(FollowCamera& view, const std::vector<const Pending*>& characters, int x, int width);
   Layout layout_;
-  std::vector<View> views_;
+  std::vector<FollowCamera> views_;
   int frame_ = 0;
+  double renderMs_ = 0.0;
+};
+
+/// The pictures a run leaves by default: a short H.264 video of its start, streamed to ffmpeg as the run
+/// goes (raw frames through a pipe: no image files on the way), and one picture, the frame of the video in
+/// which the cape covers the most of the image (its triangles' projected area), rendered again larger. Both
+/// from FollowCamera::threeQuarter(). Opening the pipe ignores SIGPIPE for the process, so that an ffmpeg
+/// that stops early is an error of finish(), not the end of the run.
+class RunMovie {
+ public:
+  struct Settings {
+    int videoWidth = 480, videoHeight = 270;      ///< px, each even (H.264's 4:2:0)
+    int pictureWidth = 960, pictureHeight = 540;  ///< px
+    int framesPerSecond = 20;                     ///< of the video: every (60 / fps)-th run frame
+    double seconds = 10.0;                        ///< of the run the video shows, from its start, s
+    std::int64_t runFrames = 0;                   ///< the run's length in 1/60 s frames
+    int videoSupersample = 1;                     ///< per side (the video is drawn as the run goes)
+    int pictureSupersample = 2;                   ///< per side (the picture is drawn once)
+  };
+  /// Starts ffmpeg (when it is on PATH) writing `video`; the picture goes to `picture` at finish(). Check
+  /// ok(): false with a reason when the GL context or the pipe cannot be made.
+  RunMovie(const std::filesystem::path& picture, const std::filesystem::path& video, int characters,
+           const Settings& settings);
+  ~RunMovie();
+  RunMovie(const RunMovie&) = delete;
+  RunMovie& operator=(const RunMovie&) = delete;
+  bool ok() const { return error_.empty(); }
+  const std::string& error() const { return error_; }
+  /// Whether run frame `frame` (1, 2, ...) is within what the video shows (later frames are not needed).
+  bool wants(std::int64_t frame) const { return frame <= windowFrames_; }
+  /// Character k's cape (kept by the caller until the last character of the frame is recorded) and body
+  /// colliders in run frame `frame`; characters in order 0, 1, ...
+  void record(std::int64_t frame, int character, const CapeMesh& mesh,
+              const std::vector<Collider>& colliders);
+  /// Closes the video and writes the picture. False with a reason when either could not be written.
+  bool finish(std::string& error);
+
+  bool writesVideo() const { return pipe_ != nullptr || videoFrames_ > 0; }  ///< false without ffmpeg
+  int videoFrames() const { return videoFrames_; }
+  std::int64_t pictureFrame() const { return best_.frame; }  ///< the run frame in the picture
+  /// Mean wall time per video frame of drawing, reading back and handing it to ffmpeg, ms.
+  double meanRenderMs() const { return videoFrames_ > 0 ? renderMs_ / videoFrames_ : 0.0; }
+
+ private:
+  struct Still {
+    std::int64_t frame = 0;
+    double score = -1.0;  ///< projected cape area, px^2 of the video's image
+    std::vector<CapeMesh> meshes;
+    std::vector<std::vector<Collider>> colliders;
+    FollowCamera camera;
+  };
+  void draw(Renderer& renderer, const Camera& camera, const std::vector<const CapeMesh*>& meshes,
+            const std::vector<std::vector<Collider>>& colliders, const Vec3& centre);
+
+  std::filesystem::path picture_, video_;
+  Settings settings_;
+  int characters_;
+  std::int64_t windowFrames_ = 0, step_ = 2, pictureFrom_ = 1;
+  std::string error_;
+  std::unique_ptr<Renderer> renderer_;
+  std::FILE* pipe_ = nullptr;
+  FollowCamera camera_;
+  std::vector<const CapeMesh*> meshes_;
+  std::vector<std::vector<Collider>> colliders_;
+  Still best_;
+  int videoFrames_ = 0;
   double renderMs_ = 0.0;
 };
 

@@ -238,7 +238,8 @@ bool isCharacterFolder(const fs::path& name) {
 }
 
 bool isRunFile(const fs::path& name, RunFolderKind kind) {
-  static const char* const walk[] = {"metrics.csv", "summary.json", "colliders.jsonl"};
+  static const char* const walk[] = {"metrics.csv", "summary.json", kPictureFile, kVideoFile,
+                                     "colliders.jsonl"};
   static const char* const compare[] = {"compare.csv",           "compare.json",          "frames_ours.csv",
                                         "frames_btsoftbody.csv", "frames_deformable.csv", "strain.png",
                                         "penetration.png",       "frame_time.png"};
@@ -346,11 +347,11 @@ bool prepareOutFolder(const fs::path& dir, RunFolderKind kind, std::string& erro
   return false;
 }
 
-fs::path freshRunFolder(const std::string& scene, const std::string& prefix) {
+fs::path freshRunFolder(const std::string& name) {
   char stamp[32];
   const std::time_t now = std::time(nullptr);
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
-  fs::path base = prefix + "_" + scene + "_" + stamp;
+  const fs::path base = fs::path("runs") / (name + "-" + stamp);
   fs::path dir = base;
   for (int k = 2; fs::exists(dir); ++k) dir = base.string() + "-" + std::to_string(k);
   return dir;

@@ -90,7 +90,8 @@ nlohmann::json frameShareFigures(const FrameTimings& timings, int capes);
 
 /// Which demo's files an output folder holds.
 enum class RunFolderKind {
-  Walk,     ///< cape_walk: metrics.csv, summary.json, colliders.jsonl, frames/[kK/]NNNNN.obj
+  Walk,     ///< cape_walk: metrics.csv, summary.json, picture.png, video.mp4, colliders.jsonl,
+            ///< frames/[kK/]NNNNN.obj
   Compare,  ///< cape_compare: compare.csv, compare.json, frames_*.csv, strain.png, penetration.png,
             ///< frame_time.png
 };
@@ -105,7 +106,12 @@ bool checkOutFolder(const std::filesystem::path& dir, RunFolderKind kind, std::s
 /// run's are all it holds. False with the reason if that fails.
 bool prepareOutFolder(const std::filesystem::path& dir, RunFolderKind kind, std::string& error);
 
-/// A fresh folder name in the current directory: <prefix>_<scene>_<YYYYmmdd-HHMMSS>[-N].
-std::filesystem::path freshRunFolder(const std::string& scene, const std::string& prefix = "cape_run");
+/// A fresh folder name under runs/ in the current directory: runs/<name>-<YYYYmmdd-HHMMSS>[-N] (local
+/// time; -2, -3, ... when that folder already exists).
+std::filesystem::path freshRunFolder(const std::string& name);
+
+/// The names of cape_walk's picture and video in its folder (summary.json's "picture" and "video").
+constexpr const char* kPictureFile = "picture.png";
+constexpr const char* kVideoFile = "video.mp4";
 
 }  // namespace cape::demo

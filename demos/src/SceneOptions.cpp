@@ -3,6 +3,7 @@
 #include "CliNumbers.h"
 
 #include "cape/character/Character.h"
+#include "cape/core/FabricPresets.h"
 
 #include <cmath>
 
@@ -12,9 +13,28 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
   app.add_option("--scene", cli.scene, "hang | walk | sprint-turn | wind | crowd")
       ->check(CLI::IsMember({"hang", "walk", "sprint-turn", "wind", "crowd"}))
       ->capture_default_str();
-  app.add_option("--size", cli.size, "particles per side of the N x N cape")
-      ->transform(strictInteger(2, 256))
+  app.add_option("--size", cli.size,
+                 "particles per side of the N x N cape; with --width or --height, particles across (the "
+                 "rows keep the cells square)")
+      ->transform(strictInteger(2, kMaxGridSide))
       ->capture_default_str();
+  app.add_option("--width", cli.width,
+                 "the cape's width, m (default: 0.6, or fitted to a URDF character's shoulders)")
+      ->transform(strictReal(kMinCapeSide, kMaxCapeSide));
+  app.add_option("--height", cli.height,
+                 "the cape's length from its top row down, m (default: 1.0, or fitted to a URDF character's "
+                 "pin height)")
+      ->transform(strictReal(kMinCapeSide, kMaxCapeSide));
+  app.add_option("--fabric", cli.fabric,
+                 "a real fabric for the cape: " + fabricNames() +
+                     " (its mass per area, stretch, shear and bending stiffness, damping and drag; "
+                     "default: the canonical cape of docs/SCENES.md)")
+      ->check(CLI::Validator(
+          [](std::string& name) {
+            return findFabric(name) ? std::string()
+                                    : "unknown fabric '" + name + "'; give one of " + fabricNames();
+          },
+          "NAME"));
   app.add_option("--attachment", cli.attachment, "corners (the two top corners) | collar (the whole top row)")
       ->check(CLI::IsMember({"corners", "collar"}))
       ->capture_default_str();
@@ -150,6 +170,9 @@ bool toRunOptions(const SceneCli& cli, RunOptions& o, std::string& error) {
   parseSceneKind(cli.scene, o.scene);
   parsePinLayout(cli.attachment, o.pinLayout);
   o.size = cli.size;
+  if (cli.width) o.capeWidth = static_cast<float>(*cli.width);
+  if (cli.height) o.capeHeight = static_cast<float>(*cli.height);
+  if (!cli.fabric.empty()) o.fabric = findFabric(cli.fabric);  // checked by the option
   o.seconds = cli.seconds;
   o.characters = o.scene == SceneKind::Crowd ? cli.characters : 1;
   o.simpleBody = cli.simpleBody;

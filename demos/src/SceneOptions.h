@@ -21,13 +21,17 @@ constexpr std::int64_t kMaxFrames = 5184000;  ///< 1/60 s frames in kMaxSeconds 
 constexpr int kMinImageSide = 16;             ///< --render-size, px (each side even, for the H.264 video)
 constexpr int kMaxImageSide = 4096;
 constexpr int kMaxCharacters = 4096;  ///< --characters: the crowd's size, on a square grid 2 m apart
+constexpr double kMinCapeSide = 0.1;  ///< --width, --height, m
+constexpr double kMaxCapeSide = 5.0;  ///< --width, --height, m
 
 struct SceneCli {
   std::string scene = "walk";
   std::string attachment = "corners";
   std::string urdf;
-  std::string attach;  ///< comma-separated link names
-  int size = 20;
+  std::string attach;                   ///< comma-separated link names
+  int size = 20;                        ///< particles per side, or across with --width or --height
+  std::optional<double> width, height;  ///< m
+  std::string fabric;                   ///< a preset's name (cape/core/FabricPresets.h); empty: none
   int characters = 3;
   double seconds = -1.0;
   bool simpleBody = false;
@@ -49,7 +53,9 @@ struct SceneCli {
   std::string motionMap;             ///< BVH joint=role,...
 };
 
-/// Adds --scene, --size, --attachment, --seconds, --characters, --simple-body, --urdf, --attach,
+/// Adds --scene, --size, --width, --height, --fabric, --attachment, --seconds, --characters, --simple-body,
+/// --urdf,
+/// --attach,
 /// --package-path, --up, --root-height, --pose, --model-up, --scale, --origin and the --motion options; every
 /// number read strictly (CliNumbers.h) within the ranges above or the option's own.
 void addSceneOptions(CLI::App& app, SceneCli& cli);

@@ -6,6 +6,7 @@
 
 #include "cape/character/Skeleton.h"
 #include "cape/character/Urdf.h"
+#include "cape/core/FabricPresets.h"
 #include "cape/scenes/Metrics.h"
 #include "cape/scenes/Scene.h"
 
@@ -22,7 +23,15 @@ namespace cape::demo {
 /// What every run is asked for; each kind uses what applies to it.
 struct RunOptions {
   SceneKind scene = SceneKind::Walk;
-  int size = 20;  ///< particles per side
+  int size = 20;  ///< particles per side; with capeWidth or capeHeight, particles across
+  /// The cape's size, m (--width, --height). Neither: the canonical 0.6 x 1.0 m (or, on a URDF character,
+  /// the size fitted to its shoulders) on a size x size grid. Either: the other one as it would have been,
+  /// and a grid `size` particles across with as many rows as keep its cells square (squareCellRows).
+  std::optional<float> capeWidth, capeHeight;
+  /// A fabric preset (cape/core/FabricPresets.h; --fabric): the cape's mass from its areal density and its
+  /// stiffness, damping and wind coefficients from applyFabric at the grid's spacing. nullptr: the
+  /// canonical cape (0.4 kg per 0.6 m^2) with `settings` as they are.
+  const FabricMaterial* fabric = nullptr;
   PinLayout pinLayout = PinLayout::Corners;
   double seconds = -1.0;  ///< < 0: the scene's own length
   int characters = 1;     ///< crowd size
@@ -43,6 +52,13 @@ struct RunOptions {
   character::MotionLoadOptions motionLoad;  ///< its format and the format's options
   character::PlaybackSettings playback;     ///< speed, start, in place
 };
+
+/// The most particles along a side of the cape (--size and the rows that --width and --height make).
+constexpr int kMaxGridSide = 256;
+
+/// Rows of a grid `columns` particles across a width x height cape (m) whose cells are square:
+/// round((columns - 1) height / width) + 1, at least 2.
+int squareCellRows(int columns, double width, double height);
 
 class SceneRun {
  public:
@@ -76,6 +92,9 @@ class SceneRun {
   virtual Vec3 up() const = 0;
   /// The cape's size (the canonical 0.6 x 1.0 m, or fitted to the character's shoulders).
   virtual CapeSize capeSize() const = 0;
+  /// The capes' settings as given to them, before the scene's own (settingsForScene): the options'
+  /// settings with the fabric preset applied, if any.
+  virtual const CapeSettings& settings() const = 0;
 };
 
 /// The run the options ask for: the shipped humanoid, a URDF character or the simple body, in a Bullet

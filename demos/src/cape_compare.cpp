@@ -232,7 +232,7 @@ int main(int argc, char** argv) {
       ->transform(strictInteger(1, 200))
       ->capture_default_str();
   app.add_option("--out", out,
-                 "output folder (default: a fresh cape_compare_<scene>_<time> folder). A folder that holds "
+                 "output folder (default: a fresh runs/compare-<scene>-<time> folder). A folder that holds "
                  "a previous cape_compare run (only compare.csv, compare.json, frames_*.csv and the three "
                  "plots) is emptied of it first; a folder with any other file is refused and left as it is");
   app.add_flag("--no-plots", noPlots, "do not draw the PNG plots");
@@ -258,14 +258,21 @@ int main(int argc, char** argv) {
     return 1;
   }
   const std::string& scene = sceneCli.scene;
-  const int size = sceneCli.size;
   const std::filesystem::path dir =
-      out.empty() ? freshRunFolder(scene, "cape_compare") : std::filesystem::path(out);
+      out.empty() ? freshRunFolder("compare-" + scene) : std::filesystem::path(out);
   std::string error;
   if (!checkOutFolder(dir, RunFolderKind::Compare, error)) {
     std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
     return 1;
   }
+
+  std::unique_ptr<SceneRun> ours = makeSceneRun(o, error);
+  if (!ours) {
+    std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
+    return 1;
+  }
+  // Every cape as ours (with --fabric, the preset's springs, damping and drag).
+  o.settings = ours->settings();
 
   // The twin's settings: the same masses, springs (structural + shear, the King's graph; bend springs
   // soften btSoftBody's stretch resistance and are left out), friction, thickness and air drag as ours
@@ -280,11 +287,6 @@ int main(int argc, char** argv) {
   twin.friction = btScalar(o.settings.friction);
   twin.margin = btScalar(o.settings.collisionThickness);
 
-  std::unique_ptr<SceneRun> ours = makeSceneRun(o, error);
-  if (!ours) {
-    std::fprintf(stderr, "cape_compare: %s\n", error.c_str());
-    return 1;
-  }
   // The deformable twin: the same links (Bullet's mass-spring force has one stiffness for every link),
   // friction and thickness, explicit steps. Its stiffness cannot be ours: with the 20 x 20 cape's 1 g nodes
   // at 1/240 s the deformable world blows up from 100 N/m (measured; ours are 20000 N/m), so the default is
@@ -335,6 +337,7 @@ int main(int argc, char** argv) {
   std::vector<SolverResult> results(static_cast<std::size_t>(1 + twinCount));
   results[0].name = "ours (XPBD cape)";
   results[0].settings = settingsJson(settingsForScene(o.scene, o.settings));
+  if (o.fabric) results[0].settings["fabric"] = o.fabric->name;
   results[1].name = "btSoftBody twin";
   results[1].settings = twinSettingsJson(twin);
   if (withDeformable) {
@@ -390,7 +393,10 @@ int main(int argc, char** argv) {
   json compare;
   compare["scene"] = scene;
   compare["body"] = ours->describe();
-  compare["grid"] = {{"columns", size}, {"rows", size}, {"particles", size * size}};
+  const Fabric& fabric = ours->cape(0).fabric();
+  compare["grid"] = {
+      {"columns", fabric.gridColumns()}, {"rows", fabric.gridRows()}, {"particles", fabric.particleCount()}};
+  compare["cape"] = {{"width_m", ours->capeSize().width}, {"height_m", ours->capeSize().height}};
   compare["frames"] = frames;
   const json ourSummary = summaryFigures(results[0].timings, results[0].recorder.summary());
   const double ourCape = ourSummary["cape_time_us_median"].get<double>();
@@ -400,8 +406,8 @@ int main(int argc, char** argv) {
          "mean_strain,p95_frame_max_strain,max_penetration_m,frames_penetration_over_1mm,self_intersections_"
          "max,"
          "pin_error_max_m,blow_up\n";
-  std::printf("cape_compare: scene %s, %d x %d cape, %" PRId64 " frames -> %s\n%s\n", scene.c_str(), size,
-              size, frames, dir.c_str(), ours->describe().c_str());
+  std::printf("cape_compare: scene %s, %d x %d cape, %" PRId64 " frames -> %s\n%s\n", scene.c_str(),
+              fabric.gridColumns(), fabric.gridRows(), frames, dir.c_str(), ours->describe().c_str());
   std::printf("%-18s %9s %9s %9s %7s %8s %8s %9s %6s %6s %9s %6s\n", "solver", "frame us", "cape us",
               "cape p95", "x ours", "strain", "mean", "pen m", ">1mm", "self", "pin m", "blowup");
   for (SolverResult& r : results) {

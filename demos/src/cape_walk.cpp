@@ -1,6 +1,7 @@
 // cape_walk: the headless walking demo. A character walks (or stands, sprints and turns, stands in the wind,
 // or walks in a crowd), its cape follows, and every metric of docs/SCENES.md is written per frame.
-// `cape_walk --help` lists the options; with none it runs the walk scene into a fresh folder it names.
+// `cape_walk --help` lists the options; with none it runs the walk scene into a fresh runs/walk-<time>
+// folder: summary.json, metrics.csv, a picture and a short video, and names the picture in its last line.
 #include "CliNumbers.h"
 #include "GltfExport.h"
 #include "Progress.h"
@@ -27,6 +28,9 @@ namespace {
 
 /// --gltf keeps every frame of every cape in memory until the run ends: a crowd of at most this many.
 constexpr int kMaxGltfCharacters = 64;
+/// The picture and the video are drawn by default for a crowd of at most this many (drawing more would
+/// take longer than their run).
+constexpr int kMaxMovieCharacters = 16;
 
 // A cape and its colliders moved from the cape's frame into the scene's (by SceneRun::frameOffset, in
 // double) and turned by `turn` (the identity, or a Z-up world into the Y-up scene frame for glTF and the
@@ -58,9 +62,10 @@ struct OutputView {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "cape_walk: a character walks headlessly with a cape; writes metrics.csv, summary.json, "
-      "frames/NNNNN.obj and colliders.jsonl to an output folder. Every number is read whole and checked "
-      "against its range before the run starts."};
+      "cape_walk: a character walks headlessly with a cape; writes summary.json, metrics.csv, a picture "
+      "(picture.png) and a short video (video.mp4) into a fresh runs/<scene>-<time> folder (or --out), and "
+      "with --frames the cape of every frame (frames/NNNNN.obj) and its colliders (colliders.jsonl). Every "
+      "number is read whole and checked against its range before the run starts."};
   app.footer(
       "Exit status: 0 when the run is done; 2 when the cape blew up; 1 when the URDF, the settings or the "
       "output cannot be used; CLI11's codes (from 100; 105 for a number out of range or not a number) for a "
@@ -69,7 +74,7 @@ int main(int argc, char** argv) {
   std::string solver = "xpbd", out;
   int threads = 1, substeps = -1;
   std::int64_t framesEvery = 1;
-  bool noFrames = false, selfCollision = false;
+  bool writeFrames = false, noFrames = false, noRender = false, selfCollision = false;
   addSceneOptions(app, sceneCli);
   app.add_option("--solver", solver, "xpbd (default) | explicit (the seed's explicit springs)")
       ->check(CLI::IsMember({"xpbd", "explicit"}))
@@ -81,24 +86,31 @@ int main(int argc, char** argv) {
       ->transform(strictInteger(1, 256))
       ->capture_default_str();
   app.add_option("--out", out,
-                 "output folder (default: a fresh cape_run_<scene>_<time> folder). A folder that holds a "
-                 "previous cape_walk run (only metrics.csv, summary.json, colliders.jsonl and "
-                 "frames/[kK/]NNNNN.obj) is emptied of it first; a folder with any other file is refused "
-                 "and left as it is");
-  app.add_flag("--no-frames", noFrames, "do not write frames/*.obj");
-  app.add_option("--frames-every", framesEvery,
-                 "write frames/NNNNN.obj and the colliders.jsonl line of every N-th frame only (frames N, "
-                 "2N, ...); metrics.csv keeps every frame")
-      ->transform(strictInteger(1, kMaxFrames))
-      ->capture_default_str();
+                 "output folder (default: a fresh runs/<scene>-<time> folder under the current one). A "
+                 "folder that holds a previous cape_walk run (only metrics.csv, summary.json, picture.png, "
+                 "video.mp4, colliders.jsonl and frames/[kK/]NNNNN.obj) is emptied of it first; a folder "
+                 "with any other file is refused and left as it is");
+  CLI::Option* framesFlag = app.add_flag(
+      "--frames", writeFrames, "also write the cape of every frame (frames/NNNNN.obj) and colliders.jsonl");
+  CLI::Option* everyOption =
+      app.add_option("--frames-every", framesEvery,
+                     "--frames for every N-th frame only (frames N, 2N, ...); metrics.csv keeps every frame")
+          ->transform(strictInteger(1, kMaxFrames));
+  app.add_flag("--no-frames", noFrames, "write no frames/*.obj and no colliders.jsonl (the default)")
+      ->excludes(framesFlag)
+      ->excludes(everyOption);
+  app.add_flag("--no-render", noRender,
+               "draw no picture.png and no video.mp4 (for timing runs: nothing but the simulation and "
+               "metrics.csv, summary.json)");
   std::string gltf, render, renderSize = "640x360";
   app.add_option("--gltf", gltf, "also write the run as an animated glTF 2.0 binary (.glb)");
   app.add_option("--render", render,
-                 "also render PNG frames (and run.mp4, run.gif with ffmpeg) into this folder");
+                 "also render every frame as PNG (and run.mp4, run.gif with ffmpeg) into this folder");
   app.add_option("--render-size", renderSize, "rendered image size, WxH")
       ->check(strictImageSize(kMinImageSide, kMaxImageSide, true))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (everyOption->count() > 0) writeFrames = true;
 
   RunOptions o;
   std::string optionError;
@@ -116,7 +128,12 @@ int main(int argc, char** argv) {
   }
   const std::string& scene = sceneCli.scene;
   const std::string& attachment = sceneCli.attachment;
-  const int size = sceneCli.size;
+  if (solver == "explicit" && o.fabric) {
+    std::fprintf(stderr,
+                 "cape_walk: --fabric sets the XPBD solver's springs; the explicit solver keeps the seed's "
+                 "(give one or the other)\n");
+    return 1;
+  }
   if (solver == "explicit") {
     o.settings = CapeSettings::unitySeed();
     o.settings.timeStep = 1.0f / 60.0f;
@@ -158,16 +175,14 @@ int main(int argc, char** argv) {
   std::unique_ptr<RunWriter> writer;
   try {
     if (!prepareOutFolder(dir, RunFolderKind::Walk, error)) throw std::runtime_error(error);
-    // A crowd without frames writes nothing per character but the summary (colliders.jsonl would hold
-    // every character's colliders in every frame).
-    const bool writeColliders = !(noFrames && o.scene == SceneKind::Crowd);
-    writer = std::make_unique<RunWriter>(dir, !noFrames, run->characterCount(), writeColliders);
+    writer = std::make_unique<RunWriter>(dir, writeFrames, run->characterCount(), writeFrames);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cape_walk: %s\n", e.what());
     return 1;
   }
   std::unique_ptr<GltfRecorder> gltfRecorder;
   std::unique_ptr<RunRenderer> renderer;
+  std::unique_ptr<RunMovie> movie;
   if (!gltf.empty() && !std::ofstream(gltf, std::ios::binary)) {
     std::fprintf(stderr, "cape_walk: cannot write %s\n", gltf.c_str());
     return 1;
@@ -179,6 +194,24 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "cape_walk: %s\n", renderer->error().c_str());
       return 1;
     }
+  }
+
+  // Last before the run: the picture and the video (ffmpeg starts here).
+  const bool drawMovie = !noRender && run->characterCount() <= kMaxMovieCharacters;
+  if (!noRender && !drawMovie)
+    std::printf(
+        "cape_walk: no picture or video for a crowd of more than %d characters (--render DIR draws "
+        "every frame)\n",
+        kMaxMovieCharacters);
+  if (drawMovie) {
+    RunMovie::Settings settings;
+    settings.runFrames = frames;
+    movie = std::make_unique<RunMovie>(dir / kPictureFile, dir / kVideoFile, run->characterCount(), settings);
+    if (!movie->ok()) {
+      std::fprintf(stderr, "cape_walk: %s\n", movie->error().c_str());
+      return 1;
+    }
+    if (!movie->writesVideo()) std::printf("cape_walk: ffmpeg is not on PATH: no %s\n", kVideoFile);
   }
 
   // Per character: the cape and its colliders in the scene's frame (when the cape's frame is elsewhere), and
@@ -200,7 +233,8 @@ int main(int argc, char** argv) {
   const Vec3 up = run->up();
   for (std::int64_t f = 1; f <= frames && !blowUp; ++f) {
     run->advanceFrame();
-    const bool kept = f % framesEvery == 0;  // frames/*.obj and colliders.jsonl
+    const bool kept = f % framesEvery == 0;        // frames/*.obj and colliders.jsonl
+    const bool filmed = movie && movie->wants(f);  // the picture's and the video's time
     FrameRow row;
     row.frame = f;
     row.time = f / 60.0;
@@ -233,18 +267,20 @@ int main(int argc, char** argv) {
       if (kept) writer->capeMesh(f, k, cape.fabric(), *x);
       if (o.up == character::UpAxis::Y) {
         if (gltfRecorder) gltfRecorder->record(k, cape.fabric(), *x, *colliders);
-        if (renderer) {
+        if (renderer || filmed) {
           OutputView& v = views[static_cast<std::size_t>(k)];
           if (v.mesh.positions.rows() == 0) v.mesh.allocate(cape.fabric(), false);
           v.mesh.update(cape.fabric(), *x);
-          renderer->record(k, v.mesh, *colliders);
+          if (renderer) renderer->record(k, v.mesh, *colliders);
+          if (filmed) movie->record(f, k, v.mesh, *colliders);
         }
-      } else if (gltfRecorder || renderer) {
+      } else if (gltfRecorder || renderer || filmed) {
         // glTF and the renderer are Y-up: a Z-up world is turned back into the scene frame for them.
         OutputView& v = views[static_cast<std::size_t>(k)];
         v.set(cape.fabric(), *x, *colliders, Eigen::Vector3d::Zero(), toScene);
         if (gltfRecorder) gltfRecorder->record(k, cape.fabric(), v.positions, v.colliders);
         if (renderer) renderer->record(k, v.mesh, v.colliders);
+        if (filmed) movie->record(f, k, v.mesh, v.colliders);
       }
       if (!kept || !writer->writesColliders()) continue;
       for (Collider c : *colliders) {
@@ -269,6 +305,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cape_walk: %s\n", error.c_str());
     return 1;
   }
+  if (movie && !movie->finish(error)) {
+    std::fprintf(stderr, "cape_walk: %s\n", error.c_str());
+    return 1;
+  }
+  if (movie && movie->writesVideo())
+    std::printf("cape_walk: %d video frames at %dx%d (%.1f ms each to draw) -> %s\n", movie->videoFrames(),
+                RunMovie::Settings().videoWidth, RunMovie::Settings().videoHeight, movie->meanRenderMs(),
+                (dir / kVideoFile).c_str());
   if (gltfRecorder) std::printf("cape_walk: glTF animation -> %s\n", gltf.c_str());
   if (renderer) {
     std::printf("cape_walk: %d frames rendered at %dx%d (%.1f ms each) -> %s\n", renderer->frames(),
@@ -283,16 +327,22 @@ int main(int argc, char** argv) {
   summary["attachment"] = attachment;
   summary["characters"] = run->characterCount();
   summary["threads"] = threads;
-  summary["grid"] = {{"columns", size},
-                     {"rows", size},
-                     {"particles", size * size},
-                     {"springs", run->cape(0).fabric().springCount()}};
+  const Fabric& fabric = run->cape(0).fabric();
+  summary["grid"] = {{"columns", fabric.gridColumns()},
+                     {"rows", fabric.gridRows()},
+                     {"particles", fabric.particleCount()},
+                     {"springs", fabric.springCount()}};
   summary["cape"] = {{"width_m", run->capeSize().width},
                      {"height_m", run->capeSize().height},
-                     {"mass_kg", run->cape(0).fabric().totalMass()}};
+                     {"mass_kg", fabric.totalMass()}};
   summary["frame_time_s"] = 1.0 / 60.0;
   summary["seconds"] = length;
-  summary["settings"] = settingsJson(settingsForScene(o.scene, o.settings));
+  summary["settings"] = settingsJson(settingsForScene(o.scene, run->settings()));
+  // The fabric preset, if any (the cape's mass and the settings above come from it).
+  summary["fabric"] = o.fabric ? nlohmann::json{{"name", o.fabric->name},
+                                                {"areal_density_kg_per_m2", o.fabric->arealDensity},
+                                                {"bending_length_m", o.fabric->bendingLength()}}
+                               : nlohmann::json();
   summary["summary"] = summaryFigures(timings, q);
   summary["summary"].update(frameShareFigures(timings, run->characterCount()));
   summary["summary"]["lowest_particle_m"] = std::isfinite(lowest) ? lowest : 0.0;
@@ -309,11 +359,19 @@ int main(int argc, char** argv) {
     for (const MetricsRecorder& r : recorders)
       summary["per_character"].push_back(summaryFigures(timings, r.summary()));
   }
+  // What a person looks at, named relative to the folder.
+  summary["picture"] = movie ? nlohmann::json(kPictureFile) : nlohmann::json();
+  summary["video"] = movie && movie->writesVideo() ? nlohmann::json(kVideoFile) : nlohmann::json();
+  if (movie) {
+    summary["picture_frame"] = movie->pictureFrame();
+    summary["video_frames"] = movie->videoFrames();
+    summary["render_ms_per_video_frame"] = movie->meanRenderMs();
+  }
   writer->summary(summary);
 
   const nlohmann::json& s = summary["summary"];
-  std::printf("cape_walk: scene %s, %d x %d cape, %d character(s), %" PRId64 " frames -> %s\n", scene.c_str(),
-              size, size, run->characterCount(), framesRun, dir.c_str());
+  std::printf("cape_walk: scene %s, %d x %d cape, %d character(s), %" PRId64 " frames\n", scene.c_str(),
+              fabric.gridColumns(), fabric.gridRows(), run->characterCount(), framesRun);
   std::printf("  %-34s %10.1f us (p95 %.1f)\n", "frame time, median", s["frame_time_us_median"].get<double>(),
               s["frame_time_us_p95"].get<double>());
   std::printf("  %-34s %10.1f us (p95 %.1f)\n", "cape time, median", s["cape_time_us_median"].get<double>(),
@@ -342,7 +400,14 @@ int main(int argc, char** argv) {
                  "cape_walk: the cape blew up at frame %" PRId64
                  " (NaN, a particle > 10 m from the torso, or particles the numerical guard restored)\n",
                  framesRun);
-    return 2;
   }
-  return 0;
+  // Last, what to open: the folder and the picture in it.
+  std::fflush(stderr);
+  std::printf("cape_walk: outputs in %s\n", dir.c_str());
+  if (movie) {
+    std::printf("cape_walk: picture %s\n", (dir / kPictureFile).c_str());
+  } else {
+    std::printf("cape_walk: no picture (%s)\n", noRender ? "--no-render" : "a large crowd");
+  }
+  return blowUp ? 2 : 0;
 }

@@ -220,8 +220,9 @@ fs::path writeHumanoid(const fs::path& dir, const Humanoid& h) {
 json runWalk(const fs::path& dir, const fs::path& urdf, const std::string& extra,
              std::string* output = nullptr) {
   const fs::path out = dir / ("run" + std::to_string(std::hash<std::string>()(extra) % 100000));
-  const Result r = run(std::string(CAPE_WALK) + " --urdf " + urdf.string() + " --package-path " +
-                       dir.string() + " --seconds 4 --no-frames --out " + out.string() + " " + extra);
+  const Result r =
+      run(std::string(CAPE_WALK) + " --urdf " + urdf.string() + " --package-path " + dir.string() +
+          " --seconds 4 --no-frames --no-render --out " + out.string() + " " + extra);
   if (output) *output = r.output;
   EXPECT_EQ(r.exitCode, 0) << r.output;
   std::ifstream in(out / "summary.json");
@@ -306,7 +307,7 @@ TEST(AnyHumanoid, MeshLinksAreHullsInCollidersJsonlAndNoParticleIsInsideOne) {
   const fs::path urdf = writeHumanoid(dir, h);
   const fs::path out = dir / "run";
   const Result r = run(std::string(CAPE_WALK) + " --urdf " + urdf.string() + " --package-path " +
-                       dir.string() + " --seconds 2 --out " + out.string());
+                       dir.string() + " --seconds 2 --frames --out " + out.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   double closest = -1.0;
   for (int frame = 10; frame <= 120; frame += 10) {
@@ -344,8 +345,8 @@ TEST(AnyHumanoid, ZUpWorldGivesTheSameMetricsAsYUp) {
   std::vector<std::vector<double>> frames[2];
   for (int u = 0; u < 2; ++u) {
     const fs::path out = dir / (u == 0 ? "framesY" : "framesZ");
-    const Result r = run(std::string(CAPE_WALK) + " --urdf " + urdf.string() + " --seconds 1 --out " +
-                         out.string() + (u == 0 ? " --up y" : " --up z"));
+    const Result r = run(std::string(CAPE_WALK) + " --urdf " + urdf.string() +
+                         " --seconds 1 --frames --out " + out.string() + (u == 0 ? " --up y" : " --up z"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     for (const std::string& l : lines(out / "frames" / "00060.obj")) {
       if (l.rfind("v ", 0) != 0) continue;

@@ -1,6 +1,6 @@
-// cape_walk end to end: a short scene runs, and metrics.csv, summary.json, frames/*.obj and colliders.jsonl
-// hold what the README says (rows = frames, OBJ vertices = particles, JSONL lines = frames); bad options
-// fail with a non-zero exit and a one-line reason.
+// cape_walk end to end: a short scene runs, and metrics.csv, summary.json and (with --frames) frames/*.obj
+// and colliders.jsonl hold what the README says (rows = frames, OBJ vertices = particles, JSONL lines =
+// frames); bad options fail with a non-zero exit and a one-line reason.
 #include "DemoTestSupport.h"
 
 #include <nlohmann/json.hpp>
@@ -78,7 +78,8 @@ void expectRunFolder(const fs::path& dir, int frames, int n, int characters, int
 
 TEST(CapeWalk, SimpleBodyWalkWritesEveryOutput) {
   const fs::path dir = freshDir();
-  const Result r = run(kWalk + " --simple-body --scene walk --size 8 --seconds 0.5 --out " + dir.string());
+  const Result r =
+      run(kWalk + " --simple-body --scene walk --size 8 --seconds 0.5 --frames --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find("strain"), std::string::npos) << "prints a summary table";
   expectRunFolder(dir, 30, 8, 1, 5);
@@ -86,7 +87,7 @@ TEST(CapeWalk, SimpleBodyWalkWritesEveryOutput) {
 
 TEST(CapeWalk, ShippedHumanoidByDefault) {
   const fs::path dir = freshDir();
-  const Result r = run(kWalk + " --size 8 --seconds 0.25 --out " + dir.string());
+  const Result r = run(kWalk + " --size 8 --seconds 0.25 --frames --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   std::ifstream in(dir / "summary.json");
   const json s = json::parse(in);
@@ -116,8 +117,8 @@ TEST(CapeWalk, UrdfWithNamedAttachmentLinks) {
           (dir / "b").string());
   EXPECT_NE(r.exitCode, 0);
   EXPECT_NE(r.output.find("unknown link \"nose\""), std::string::npos) << r.output;
-  r = run(kWalk + " --urdf " + urdf.string() + " --attach neck --scene hang --size 6 --seconds 0.5 --out " +
-          (dir / "c").string());
+  r = run(kWalk + " --urdf " + urdf.string() +
+          " --attach neck --scene hang --size 6 --seconds 0.5 --frames --out " + (dir / "c").string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   expectRunFolder(dir / "c", 30, 6, 1, 2);
 }
@@ -137,7 +138,7 @@ TEST(CapeWalk, CrowdResultsDoNotDependOnTheThreadCount) {
   for (int threads = 1; threads <= 2; ++threads) {
     const fs::path out = dir / ("t" + std::to_string(threads));
     const Result r = run(kWalk + " --scene crowd --characters 3 --threads " + std::to_string(threads) +
-                         " --size 8 --seconds 0.5 --out " + out.string());
+                         " --size 8 --seconds 0.5 --frames --no-render --out " + out.string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
     // Everything but the timing columns (2 and 3).
     for (const std::string& l : lines(out / "metrics.csv")) {
@@ -158,25 +159,29 @@ TEST(CapeWalk, CrowdResultsDoNotDependOnTheThreadCount) {
 
 TEST(CapeWalk, CrowdWritesFramesPerCharacter) {
   const fs::path dir = freshDir();
-  const Result r = run(kWalk + " --simple-body --scene crowd --characters 3 --size 6 --seconds 0.25 --out " +
-                       dir.string());
+  const Result r =
+      run(kWalk + " --simple-body --scene crowd --characters 3 --size 6 --seconds 0.25 --frames --out " +
+          dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   expectRunFolder(dir, 15, 6, 3, 5);
 }
 
-TEST(CapeWalk, NoFramesWritesNoObj) {
+TEST(CapeWalk, NoFramesWritesNoObjAndNoColliders) {
   const fs::path dir = freshDir();
   const Result r = run(kWalk + " --simple-body --size 6 --seconds 0.1 --no-frames --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_FALSE(fs::exists(dir / "frames"));
+  EXPECT_FALSE(fs::exists(dir / "colliders.jsonl"));
   EXPECT_EQ(lines(dir / "metrics.csv").size(), 7u);
 }
 
 TEST(CapeWalk, HelpListsTheOptions) {
   const Result r = run(kWalk + " --help");
   EXPECT_EQ(r.exitCode, 0);
-  for (const char* option : {"--scene", "--size", "--attachment", "--seconds", "--solver", "--characters",
-                             "--threads", "--out", "--no-frames", "--simple-body", "--urdf", "--attach"})
+  for (const char* option :
+       {"--scene", "--size", "--width", "--height", "--attachment", "--seconds", "--solver", "--characters",
+        "--threads", "--out", "--frames", "--no-frames", "--frames-every", "--no-render", "--simple-body",
+        "--urdf", "--attach", "runs/<scene>-<time>"})
     EXPECT_NE(r.output.find(option), std::string::npos) << option;
 }
 
@@ -184,7 +189,8 @@ TEST(CapeWalk, BadOptionsFailWithAReason) {
   const fs::path dir = freshDir();
   for (const std::string args :
        {"--scene dance", "--size 0", "--seconds -1", "--urdf /nonexistent/robot.urdf", "--solver magic",
-        "--attachment belt", "--frobnicate"}) {
+        "--attachment belt", "--frobnicate", "--width 0", "--height -1", "--frames --no-frames",
+        "--no-frames --frames-every 3", "--size 256 --width 0.1 --height 5"}) {
     const Result r = run(kWalk + " " + args + " --out " + (dir / "x").string());
     EXPECT_NE(r.exitCode, 0) << args;
     EXPECT_FALSE(r.output.empty()) << args << ": no reason given";

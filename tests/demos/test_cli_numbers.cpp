@@ -115,6 +115,9 @@ TEST(CliNumbers, EveryBadNumberIsRefusedBeforeAnythingIsWritten) {
       {"--seconds 2s", "--seconds: '2s' is not a decimal number"},
       {"--size 0x10", "--size: '0x10' is not a whole number; give a whole number from 2 to 256"},
       {"--size 4294967316", "--size: '4294967316' is out of range"},
+      {"--width 0.05", "--width: '0.05' is out of range; give a number from 0.1 to 5"},
+      {"--height 5.5", "--height: '5.5' is out of range; give a number from 0.1 to 5"},
+      {"--height 1m", "--height: '1m' is not a decimal number"},
       {"--characters 4097", "--characters: '4097' is out of range; give a whole number from 1 to 4096"},
       {"--scale nan", "--scale: 'nan' is not a decimal number; give a number from 0.001 to 1000"},
       {"--root-height 1e309", "--root-height: '1e309' is out of range; give a number from -1000 to 1000"},
@@ -192,20 +195,26 @@ TEST(FramesEvery, ThreeWritesEveryThirdFrameAndEveryMetricsRow) {
 TEST(OutFolder, ASecondRunLeavesOnlyItsOwnFiles) {
   const fs::path dir = freshDir();
   // A crowd with frames, then a shorter single-character run: no k0/, no frames beyond the 6th.
-  Result r = run(kWalk + " --simple-body --scene crowd --characters 2 --size 6 --seconds 0.25 --out " +
-                 dir.string());
+  Result r =
+      run(kWalk + " --simple-body --scene crowd --characters 2 --size 6 --seconds 0.25 --frames --out " +
+          dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   ASSERT_TRUE(fs::exists(dir / "frames" / "k1" / "00015.obj"));
-  r = run(kWalk + " --simple-body --size 6 --seconds 0.1 --out " + dir.string());
+  r = run(kWalk + " --simple-body --size 6 --seconds 0.1 --frames --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  std::set<std::string> expected = {"metrics.csv", "summary.json", "colliders.jsonl", "frames"};
+  std::set<std::string> expected = {"metrics.csv", "summary.json",    "picture.png",
+                                    "video.mp4",   "colliders.jsonl", "frames"};
   for (int f = 1; f <= 6; ++f) expected.insert("frames/0000" + std::to_string(f) + ".obj");
   EXPECT_EQ(tree(dir), expected);
   EXPECT_EQ(lines(dir / "colliders.jsonl").size(), 6u);
-  // And without frames: the folder goes.
-  r = run(kWalk + " --simple-body --size 6 --seconds 0.1 --no-frames --out " + dir.string());
+  // And without frames (the default): frames/ and colliders.jsonl go; without the picture, it and the
+  // video go.
+  r = run(kWalk + " --simple-body --size 6 --seconds 0.1 --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  EXPECT_EQ(tree(dir), (std::set<std::string>{"metrics.csv", "summary.json", "colliders.jsonl"}));
+  EXPECT_EQ(tree(dir), (std::set<std::string>{"metrics.csv", "summary.json", "picture.png", "video.mp4"}));
+  r = run(kWalk + " --simple-body --size 6 --seconds 0.1 --no-frames --no-render --out " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(tree(dir), (std::set<std::string>{"metrics.csv", "summary.json"}));
 
   // cape_compare's own files: a run with the deformable twin, then one without it.
   const fs::path cmp = dir / "compare";
@@ -222,7 +231,7 @@ TEST(OutFolder, ASecondRunLeavesOnlyItsOwnFiles) {
 
 TEST(OutFolder, AFolderWithOtherFilesIsRefusedAndLeftAsItIs) {
   const fs::path dir = freshDir();
-  Result r = run(kWalk + " --simple-body --size 6 --seconds 0.1 --out " + dir.string());
+  Result r = run(kWalk + " --simple-body --size 6 --seconds 0.1 --frames --no-render --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   std::ofstream(dir / "notes.txt") << "mine";
   std::ofstream(dir / "frames" / "keep.txt") << "mine too";

@@ -72,7 +72,7 @@ TEST(Crowd, StandsOnASquareGridTwoMetresApartCentredOnTheOrigin) {
   // 1000 characters: rows of 32, 32 rows (the last one short), one frame.
   const fs::path dir = freshDir() / "run";
   const Result r = run(kWalk + " --simple-body --scene crowd --characters 1000 --size 4 --seconds 0.017 " +
-                       "--out " + dir.string());
+                       "--frames --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const auto at = torsos(dir);
   ASSERT_EQ(at.size(), 1000u);
@@ -100,7 +100,7 @@ TEST(Crowd, StandsOnASquareGridTwoMetresApartCentredOnTheOrigin) {
 TEST(Crowd, UrdfCharactersStandOnTheGridToo) {
   const fs::path dir = freshDir() / "run";
   const Result r =
-      run(kWalk + " --scene crowd --characters 5 --size 4 --seconds 0.017 --out " + dir.string());
+      run(kWalk + " --scene crowd --characters 5 --size 4 --seconds 0.017 --frames --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const json s = summaryOf(dir);
   EXPECT_EQ(s["characters"].get<int>(), 5);
@@ -126,7 +126,7 @@ TEST(Crowd, UrdfCharactersStandOnTheGridToo) {
 TEST(Crowd, FrameSplitsIntoCapesAndBullet) {
   const fs::path dir = freshDir() / "run";
   const Result r = run(kWalk + " --simple-body --scene crowd --characters 16 --size 8 --seconds 0.5 " +
-                       "--no-frames --threads 2 --out " + dir.string());
+                       "--no-frames --no-render --threads 2 --out " + dir.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const json s = summaryOf(dir)["summary"];
   const double frame = s["frame_time_us_median"], cape = s["cape_time_us_median"],

@@ -64,7 +64,7 @@ TEST(FarOrigin, CrowdOutputsAreInOneFrameThoughEachCapeHasItsOwn) {
   constexpr int kCount = 100, kColumns = 10;
   const fs::path dir = freshDir();
   const Result r = run(std::string(CAPE_WALK) + " --scene crowd --characters " + std::to_string(kCount) +
-                       " --size 6 --seconds 0.25 --out " + (dir / "crowd").string());
+                       " --size 6 --seconds 0.25 --frames --out " + (dir / "crowd").string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const std::vector<std::string> jsonl = lines(dir / "crowd" / "colliders.jsonl");
   ASSERT_FALSE(jsonl.empty());

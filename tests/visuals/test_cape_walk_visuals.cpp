@@ -1,8 +1,10 @@
 // cape_walk's --gltf and --render end to end: a short simple-body walk exports a .glb that loads back and
-// renders frames of the requested size; bad paths and sizes fail with a one-line reason.
+// renders frames of the requested size; bad paths and sizes fail with a one-line reason. The default run's
+// picture shows the cape whole.
 #include "DemoTestSupport.h"
 
 #include <gtest/gtest.h>
+#include <png.h>
 #include <tiny_gltf.h>
 
 #include <cmath>
@@ -34,7 +36,56 @@ bool pngSize(const fs::path& file, unsigned& width, unsigned& height) {
   return true;
 }
 
+/// An RGB PNG read whole (libpng's simplified API), rows from the top.
+bool readPng(const fs::path& file, unsigned& width, unsigned& height, std::vector<unsigned char>& rgb) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, file.c_str())) return false;
+  image.format = PNG_FORMAT_RGB;
+  rgb.resize(PNG_IMAGE_SIZE(image));
+  if (!png_image_finish_read(&image, nullptr, rgb.data(), 0, nullptr)) return false;
+  width = image.width;
+  height = image.height;
+  return true;
+}
+
 }  // namespace
+
+// The picture of a default run: 960 x 540, the cape's red outside (or its gold lining) over a good share
+// of it, and all of the cape inside the image, away from its edges.
+TEST(CapeWalkVisuals, TheDefaultPictureShowsTheWholeCape) {
+  const fs::path dir = freshDir();
+  for (const std::string scene : {"walk", "sprint-turn"}) {
+    const fs::path out = dir / scene;
+    const Result r = runWalk("--scene " + scene + " --seconds 3 --out " + out.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    unsigned w = 0, h = 0;
+    std::vector<unsigned char> rgb;
+    ASSERT_TRUE(readPng(out / "picture.png", w, h, rgb)) << scene;
+    ASSERT_EQ(w, 960u);
+    ASSERT_EQ(h, 540u);
+    std::size_t cape = 0;
+    unsigned left = w, right = 0, top = h, bottom = 0;
+    for (unsigned y = 0; y < h; ++y) {
+      for (unsigned x = 0; x < w; ++x) {
+        const unsigned char* p = &rgb[3 * (static_cast<std::size_t>(y) * w + x)];
+        const int r8 = p[0], g8 = p[1], b8 = p[2];
+        const bool outside = r8 > 60 && r8 > 2 * g8 && r8 > 2 * b8;
+        const bool lining = r8 > 90 && g8 > 60 && b8 < g8 / 2 && r8 > g8;
+        if (!outside && !lining) continue;
+        ++cape;
+        left = std::min(left, x), right = std::max(right, x), top = std::min(top, y),
+        bottom = std::max(bottom, y);
+      }
+    }
+    EXPECT_GT(cape, static_cast<std::size_t>(w) * h / 50) << scene << ": the cape covers under 2 %";
+    EXPECT_GT(left, w / 20) << scene;
+    EXPECT_LT(right, w - w / 20) << scene;
+    EXPECT_GT(top, h / 20) << scene;
+    EXPECT_LT(bottom, h - h / 20) << scene;
+  }
+  fs::remove_all(dir);
+}
 
 TEST(CapeWalkVisuals, GltfAndRenderOfAShortWalk) {
   const fs::path dir = freshDir();
