@@ -4,10 +4,26 @@
 
 #include "cape/character/Character.h"
 #include "cape/core/FabricPresets.h"
+#include "cape/core/Version.h"
+
+#include <LinearMath/btScalar.h>
 
 #include <cmath>
+#include <string>
 
 namespace cape::demo {
+
+void addVersionFlag(CLI::App& app, const std::string& tool) {
+#ifdef BT_USE_DOUBLE_PRECISION
+  const char* precision = "double";
+#else
+  const char* precision = "single";
+#endif
+  const int bullet = btGetVersion();
+  app.set_version_flag("--version", tool + " " + cape::version() + " (CapeCloth " + cape::version() +
+                                        ", Bullet " + std::to_string(bullet / 100) + "." +
+                                        std::to_string(bullet % 100) + ", " + precision + " precision)");
+}
 
 void addSceneOptions(CLI::App& app, SceneCli& cli) {
   app.add_option("--scene", cli.scene, "hang | walk | sprint-turn | wind | crowd")

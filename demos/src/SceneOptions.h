@@ -53,6 +53,10 @@ struct SceneCli {
   std::string motionMap;             ///< BVH joint=role,...
 };
 
+/// Adds --version: "<tool> <version>" with the library's version (cape::version()), Bullet's version and its
+/// precision; prints it and exits 0.
+void addVersionFlag(CLI::App& app, const std::string& tool);
+
 /// Adds --scene, --size, --width, --height, --fabric, --attachment, --seconds, --characters, --simple-body,
 /// --urdf,
 /// --attach,

@@ -217,6 +217,7 @@ int main(int argc, char** argv) {
       "per "
       "solver and writes compare.csv, compare.json and PNG plots. Every number is read whole and checked "
       "against its range before the run starts."};
+  addVersionFlag(app, "cape_compare");
   app.footer(
       "Exit status: 0 when the run is done; 1 when the URDF, the settings or the output cannot be used; "
       "CLI11's codes (from 100; 105 for a number out of range or not a number) for a bad command line.");

@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
       "(picture.png) and a short video (video.mp4) into a fresh runs/<scene>-<time> folder (or --out), and "
       "with --frames the cape of every frame (frames/NNNNN.obj) and its colliders (colliders.jsonl). Every "
       "number is read whole and checked against its range before the run starts."};
+  addVersionFlag(app, "cape_walk");
   app.footer(
       "Exit status: 0 when the run is done; 2 when the cape blew up; 1 when the URDF, the settings or the "
       "output cannot be used; CLI11's codes (from 100; 105 for a number out of range or not a number) for a "

@@ -10,8 +10,8 @@
 #include <cstring>
 
 int main() {
-  std::printf("consumer: CapeCloth headers %s, library %s, package %s\n", CAPE_VERSION_STRING, cape::version(),
-              CAPE_PACKAGE_VERSION);
+  std::printf("consumer: CapeCloth headers %s, library %s, package %s\n", CAPE_VERSION_STRING,
+              cape::version(), CAPE_PACKAGE_VERSION);
   if (std::strcmp(cape::version(), CAPE_VERSION_STRING) != 0 ||
       std::strcmp(cape::version(), CAPE_PACKAGE_VERSION) != 0) {
     std::fprintf(stderr, "consumer: the versions differ\n");

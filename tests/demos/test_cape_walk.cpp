@@ -3,6 +3,8 @@
 // frames); bad options fail with a non-zero exit and a one-line reason.
 #include "DemoTestSupport.h"
 
+#include "cape/core/Version.h"
+
 #include <nlohmann/json.hpp>
 
 namespace cape::demo_test {
@@ -183,6 +185,19 @@ TEST(CapeWalk, HelpListsTheOptions) {
         "--threads", "--out", "--frames", "--no-frames", "--frames-every", "--no-render", "--simple-body",
         "--urdf", "--attach", "runs/<scene>-<time>"})
     EXPECT_NE(r.output.find(option), std::string::npos) << option;
+}
+
+TEST(CapeWalk, BothToolsReportTheLibrarysVersion) {
+  // The one version of the project (cape::version(), CAPE_VERSION_STRING), with Bullet's and its precision.
+  for (const std::string& tool : {kWalk, std::string(CAPE_COMPARE)}) {
+    const Result r = run(tool + " --version");
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find(std::string(" ") + cape::version() + " (CapeCloth " + CAPE_VERSION_STRING),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("Bullet "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(" precision)"), std::string::npos) << r.output;
+  }
 }
 
 TEST(CapeWalk, BadOptionsFailWithAReason) {

@@ -2,6 +2,8 @@
 
 namespace cape {
 
-const char* version() { return CAPE_VERSION_STRING; }
+const char* version() {
+  return CAPE_VERSION_STRING;
+}
 
 }  // namespace cape
