@@ -45,6 +45,21 @@ for v in 0.1 0.3 1.0; do
   echo "find_package(CapeCloth $v): refused"
 done
 
+if [ "$with_bullet" -eq 1 ]; then
+  echo "-- a machine without Bullet: find_package fails and says what is needed"
+  # Bullet's CMake package disabled and pkg-config pointed at an empty folder: neither way finds Bullet.
+  mkdir -p "$work/no-pc"
+  if PKG_CONFIG_LIBDIR="$work/no-pc" PKG_CONFIG_PATH="" cmake -S "$here" -B "$work/no-bullet" \
+      -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_DISABLE_FIND_PACKAGE_Bullet=ON -DCAPE_CONSUMER_NEEDS_BULLET=ON \
+      >"$work/no-bullet.log" 2>&1; then
+    echo "find_package(CapeCloth ... bullet) succeeded without Bullet"; exit 1
+  fi
+  # (CMake wraps the message's lines: compare with the whitespace squeezed.)
+  message="$(tr -s ' \n' '  ' <"$work/no-bullet.log")"
+  grep -q "apt-get install libbullet-dev" <<<"$message" || { cat "$work/no-bullet.log"; exit 1; }
+  grep -o "CapeCloth's Bullet parts need[^:]*" <<<"$message" | head -n 1
+fi
+
 echo "-- pkg-config"
 export PKG_CONFIG_PATH="$libdir/pkgconfig${PKG_CONFIG_PATH:+:$PKG_CONFIG_PATH}"
 static=""
