@@ -88,9 +88,8 @@ if(NOT TARGET CapeCloth::Bullet)
 endif()
 
 if(NOT TARGET CapeCloth::Bullet)
-  set(CAPE_BULLET_MISSING
+  string(CONCAT CAPE_BULLET_MISSING
       "CapeCloth's Bullet parts need ${_cape_bt_what} (LinearMath, BulletCollision, BulletDynamics, BulletSoftBody): "
       "neither Bullet's CMake package (${_cape_bt_config}, in the folder Bullet_DIR names) nor pkg-config's "
       "${_cape_bt_pc}.pc (found through PKG_CONFIG_PATH) was found. On Debian or Ubuntu: apt-get install libbullet-dev.")
-  string(CONCAT CAPE_BULLET_MISSING ${CAPE_BULLET_MISSING})
 endif()
