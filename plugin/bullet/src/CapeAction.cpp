@@ -135,10 +135,14 @@ void CapeAction::warnOnce(const std::string& key, const std::string& message) {
   if (warn_) warn_(message);
 }
 
+btVector3 CapeAction::toWorld(const Vec3& framePoint) const {
+  const Eigen::Vector3d x = framePoint.cast<double>() + cape_.origin();
+  return btVector3(btScalar(x.x()), btScalar(x.y()), btScalar(x.z()));
+}
+
 btVector3 CapeAction::position(std::uint32_t particle) const {
   if (particle >= particleCount()) return btVector3(0, 0, 0);
-  const Eigen::Vector3d x = cape_.state().positions.row(particle).transpose().cast<double>() + cape_.origin();
-  return btVector3(btScalar(x.x()), btScalar(x.y()), btScalar(x.z()));
+  return toWorld(cape_.state().positions.row(particle).transpose());
 }
 
 btScalar CapeAction::maxPinError() const {
@@ -646,16 +650,8 @@ void CapeAction::debugDraw(btIDebugDraw* drawer) {
   if (drawer == nullptr || !ok()) return;
   const int mode = drawer->getDebugMode();
   const CapeState& state = cape_.state();
-  const Eigen::Vector3d& origin = cape_.origin();
   // Everything is computed in the cape's frame (where the particles and colliders are precise) and drawn in
-  // the world's.
-  const auto world = [&origin](const Vec3& p) {
-    const Eigen::Vector3d x = p.cast<double>() + origin;
-    return btVector3(btScalar(x.x()), btScalar(x.y()), btScalar(x.z()));
-  };
-  const auto direction = [](const Vec3& v) {
-    return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z()));
-  };
+  // the world's (toWorld; directions need no shift: toBt).
   // The faces, filled (drawTriangle with the face's normal at its three corners: the counter-clockwise side
   // is the front); their edges with DBG_DrawWireframe, their normals (5 cm) with DBG_DrawNormals.
   const btVector3 edgeColor = debugColor_ * btScalar(0.5);
@@ -667,7 +663,7 @@ void CapeAction::debugDraw(btIDebugDraw* drawer) {
     const Vec3 cross = (pb - pa).cross(pc - pa);
     const float length = cross.norm();
     const Vec3 n = length > 0.0f && std::isfinite(length) ? Vec3(cross / length) : Vec3::Zero();
-    const btVector3 a = world(pa), b = world(pb), c = world(pc), bn = direction(n);
+    const btVector3 a = toWorld(pa), b = toWorld(pb), c = toWorld(pc), bn = toBt(n);
     drawer->drawTriangle(a, b, c, bn, bn, bn, debugColor_, btScalar(1));
     if (mode & btIDebugDraw::DBG_DrawWireframe) {
       drawer->drawLine(a, b, edgeColor);
@@ -676,12 +672,12 @@ void CapeAction::debugDraw(btIDebugDraw* drawer) {
     }
     if (mode & btIDebugDraw::DBG_DrawNormals) {
       const Vec3 centre = (pa + pb + pc) / 3.0f;
-      drawer->drawLine(world(centre), world(centre + 0.05f * n), normalColor);
+      drawer->drawLine(toWorld(centre), toWorld(centre + 0.05f * n), normalColor);
     }
   }
   // The pins: a 1 cm sphere at each pin's target, in the colour of Bullet's constraints.
   const btVector3 pinColor = drawer->getDefaultColors().m_disabledSimulationObject;
-  for (const Pin& pin : state.pins) drawer->drawSphere(world(pin.target), btScalar(0.01), pinColor);
+  for (const Pin& pin : state.pins) drawer->drawSphere(toWorld(pin.target), btScalar(0.01), pinColor);
   // The contacts, when the drawer asks for contact points: each particle within the cape's thickness (and
   // the collider's) of a collider of the last step, at the collider's nearest surface point, with the
   // normal towards the particle and the signed distance (negative: inside), as Bullet draws its own.
@@ -698,14 +694,14 @@ void CapeAction::debugDraw(btIDebugDraw* drawer) {
         const Vec3 towards = p - q;
         const float length = towards.norm();
         const Vec3 n = length > 0.0f && std::isfinite(length) ? Vec3(towards / length) : Vec3::UnitY();
-        drawer->drawContactPoint(world(q), direction(d < 0.0f ? Vec3(-n) : n), btScalar(d), 0, contactColor);
+        drawer->drawContactPoint(toWorld(q), toBt(d < 0.0f ? Vec3(-n) : n), btScalar(d), 0, contactColor);
       }
     }
   }
   if (mode & btIDebugDraw::DBG_DrawAabb) {
     const Vec3 lo = state.positions.colwise().minCoeff().transpose();
     const Vec3 hi = state.positions.colwise().maxCoeff().transpose();
-    drawer->drawAabb(world(lo), world(hi), drawer->getDefaultColors().m_aabb);
+    drawer->drawAabb(toWorld(lo), toWorld(hi), drawer->getDefaultColors().m_aabb);
   }
 }
 

@@ -259,6 +259,8 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   void refreshPinIndices();
   /// A world pose in the cape's frame (the origin subtracted in double), and the frame's grid point near p.
   btTransform toFrame(const btTransform& world) const;
+  /// A point of the cape's frame (relative to Cape::origin) in the world, m.
+  btVector3 toWorld(const Vec3& framePoint) const;
   Eigen::Vector3d gridPoint(const btVector3& worldPoint) const;
   /// Moves the cape's frame to `origin` (the cape stays put in the world, or jumps with the frame when
   /// `carry`) and re-expresses every followed pose in it.
