@@ -85,24 +85,8 @@ bool BulletScene::makeRig(const CapeSize& fitted, std::string& error) {
       error = line;
       return false;
     }
-    rig_ = makeCapeRig(o.size, o.pinLayout, bend, capeSize_);
-    if (rig_.fabric && (rows != o.size || o.fabric)) {
-      GridDesc g;
-      g.columns = o.size;
-      g.rows = rows;
-      g.width = capeSize_.width;
-      g.height = capeSize_.height;
-      g.totalMass =
-          o.fabric ? fabricMass(*o.fabric, capeSize_.width, capeSize_.height) : rig_.fabric->totalMass();
-      g.bendSprings = bend;
-      g.tetherAnchors = rig_.pinnedParticles;
-      FabricResult made = Fabric::grid(g);
-      if (!made) {
-        error = "cannot build the cape: " + made.status.message();
-        return false;
-      }
-      rig_.fabric = made.fabric;
-    }
+    rig_ = makeCapeRig(o.size, o.pinLayout, bend, capeSize_, rows,
+                       o.fabric ? fabricMass(*o.fabric, capeSize_.width, capeSize_.height) : 0.0f);
   }
   if (!rig_.fabric) {
     error = "cannot build a " + std::to_string(o.size) + " particle wide cape";

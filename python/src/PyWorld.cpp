@@ -88,24 +88,14 @@ const cape::FabricMaterial* fabricOf(const CapeSpec& spec) {
   return m;
 }
 
-/// makeCapeRig's cape, rebuilt with the fabric preset's mass per area when one is named.
+/// makeCapeRig's cape, with the fabric preset's mass per area when one is named.
 cape::CapeRig makeRig(const CapeSpec& spec, cape::PinLayout layout, const cape::CapeSize& size) {
-  cape::CapeRig rig = cape::makeCapeRig(spec.resolution, layout, spec.settings.bendStiffness > 0.0f, size);
+  const cape::FabricMaterial* m = fabricOf(spec);
+  cape::CapeRig rig = cape::makeCapeRig(spec.resolution, layout, spec.settings.bendStiffness > 0.0f, size, 0,
+                                        m ? cape::fabricMass(*m, size.width, size.height) : 0.0f);
   if (!rig.fabric)
     throw std::runtime_error("cannot build a cape of " + std::to_string(spec.resolution) +
                              " particles a side");
-  if (const cape::FabricMaterial* m = fabricOf(spec)) {
-    cape::GridDesc g;
-    g.columns = g.rows = spec.resolution;
-    g.width = size.width;
-    g.height = size.height;
-    g.totalMass = cape::fabricMass(*m, size.width, size.height);
-    g.bendSprings = spec.settings.bendStiffness > 0.0f;
-    g.tetherAnchors = rig.pinnedParticles;
-    cape::FabricResult made = cape::Fabric::grid(g);
-    if (!made) throw std::runtime_error("cannot build the cape: " + made.status.message());
-    rig.fabric = made.fabric;
-  }
   return rig;
 }
 

@@ -193,7 +193,8 @@ void SimpleBody::moveTo(const BodyPose& pose, bool teleport) {
   }
 }
 
-CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings, const CapeSize& size) {
+CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings, const CapeSize& size, int rows,
+                    float totalMass) {
   CapeRig rig;
   const int cols = std::max(n, 2);
   if (layout == PinLayout::Corners) {
@@ -208,11 +209,11 @@ CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings, const CapeSize& s
   }
   GridDesc g;
   g.columns = n;
-  g.rows = n;
+  g.rows = rows > 0 ? rows : n;
   g.width = 2.0f * half;
   g.height = size.height;
   // 0.4 kg on the canonical 0.6 m^2; the same mass per area on any other size (exactly 0.4 on the canonical).
-  g.totalMass = 0.4f * ((g.width * g.height) / (2.0f * kPinLine.x() * 1.0f));
+  g.totalMass = totalMass > 0.0f ? totalMass : 0.4f * ((g.width * g.height) / (2.0f * kPinLine.x() * 1.0f));
   g.bendSprings = bendSprings;
   g.tetherAnchors = rig.pinnedParticles;
   rig.fabric = Fabric::grid(g).fabric;

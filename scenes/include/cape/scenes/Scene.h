@@ -107,9 +107,11 @@ struct CapeSize {
   float height = 1.0f;  ///< m, from the top row down
 };
 /// The N x N cape (the canonical 0.6 m x 1.0 m, 0.4 kg; another size keeps its mass per area) with tethers
-/// to its attachment particles, its top row centred on the canonical pin line.
+/// to its attachment particles, its top row centred on the canonical pin line. `rows` > 0 gives it that many
+/// rows instead of N (N stays the particles across); `totalMass` > 0 (kg) replaces the canonical mass per
+/// area (e.g. a fabric preset's, cape::fabricMass).
 CAPE_SCENES_API CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings = true,
-                                    const CapeSize& size = CapeSize());
+                                    const CapeSize& size = CapeSize(), int rows = 0, float totalMass = 0.0f);
 /// The cape's starting placement in the character frame: flat and vertical at z = 0.15 with its top row on
 /// the pins, or for "hang" flat and horizontal reaching from the pins towards +Z.
 CAPE_SCENES_API Pose capeStartPlacement(SceneKind kind, const CapeSize& size = CapeSize());
