@@ -11,9 +11,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <map>
-#include <regex>
 #include <set>
 
 namespace cape::demo_test {
@@ -33,6 +33,17 @@ fs::path freshWorkDir() {
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
+}
+
+/// Whether `name` is `prefix` followed by a run's time, YYYYmmdd-HHMMSS (8 digits, a dash, 6 digits).
+/// (Not std::regex: GCC 12 warns inside <regex> at -O1 with the sanitizers, and CI builds with -Werror.)
+bool isRunFolder(const std::string& name, const std::string& prefix) {
+  if (name.size() != prefix.size() + 15 || name.compare(0, prefix.size(), prefix) != 0) return false;
+  for (std::size_t k = 0; k < 15; ++k) {
+    const char c = name[prefix.size() + k];
+    if (k == 8 ? c != '-' : !std::isdigit(static_cast<unsigned char>(c))) return false;
+  }
+  return true;
 }
 
 /// Runs `arguments` with `work` as the current directory.
@@ -118,8 +129,7 @@ TEST(DefaultRun, WritesOnlyWhatAPersonLooksAtUnderFiveMegabytes) {
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const fs::path dir = onlyRunFolder(work);
   ASSERT_FALSE(dir.empty()) << "one folder in runs/";
-  EXPECT_TRUE(std::regex_match(dir.filename().string(), std::regex("walk-[0-9]{8}-[0-9]{6}")))
-      << dir.filename();
+  EXPECT_TRUE(isRunFolder(dir.filename().string(), "walk-")) << dir.filename();
   EXPECT_EQ(tree(dir), (std::set<std::string>{"summary.json", "metrics.csv", "picture.png", "video.mp4"}));
   EXPECT_EQ(tree(work), (std::set<std::string>{"runs", "runs/" + dir.filename().string(),
                                                "runs/" + dir.filename().string() + "/summary.json",
@@ -204,8 +214,7 @@ TEST(DefaultRun, CapeCompareWritesIntoRunsToo) {
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const fs::path dir = onlyRunFolder(work);
   ASSERT_FALSE(dir.empty());
-  EXPECT_TRUE(std::regex_match(dir.filename().string(), std::regex("compare-walk-[0-9]{8}-[0-9]{6}")))
-      << dir.filename();
+  EXPECT_TRUE(isRunFolder(dir.filename().string(), "compare-walk-")) << dir.filename();
   EXPECT_TRUE(fs::exists(dir / "compare.json"));
 }
 
