@@ -32,13 +32,6 @@ using nlohmann::json;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRate = 30.0;  // samples per second of every clip
-// The sanitized build (CI's Debug + ASan/UBSan run) looks for memory errors and runs each clip half as long;
-// the Release run measures the whole length.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr double kRunShare = 0.5;
-#else
-constexpr double kRunShare = 1.0;
-#endif
 
 // --- One stride model: the angles of a gait cycle, flexion positive (thigh and arm forward, shin back) -----
 
@@ -326,8 +319,8 @@ std::array<double, 2> bodyCentre(const json& line) {
 json playAndMeasure(const fs::path& dir, const Play& p) {
   const fs::path out = dir / "run";
   std::string command = std::string(CAPE_WALK) + " --motion " + p.clip.string() + " --self-collision" +
-                        " --seconds " + std::to_string(kRunShare * p.stride->seconds) +
-                        " --frames-every 10 --out " + out.string();
+                        " --seconds " + std::to_string(p.stride->seconds) + " --frames-every 10 --out " +
+                        out.string();
   if (!p.urdf.empty()) command += " --urdf " + p.urdf.string() + " " + p.modelOptions;
   const Result r = run(command);
   EXPECT_EQ(r.exitCode, 0) << p.what << "\n" << r.output;
