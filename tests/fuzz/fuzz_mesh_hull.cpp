@@ -50,6 +50,7 @@ void checkHull(const cape::character::MeshHull& h, int budget) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace cape::character;
+  capefuzz::hugePagesForLargeBlocks();
   capefuzz::ByteReader in(data, size);
   const char* extension = capefuzz::meshExtension(in.u8());
   MeshHullOptions options;

@@ -36,6 +36,7 @@ const std::vector<std::size_t>& linkBodies() {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace cape::character;
+  capefuzz::hugePagesForLargeBlocks();
   capefuzz::ByteReader in(data, size);
   const std::string file = std::string("mesh.") + capefuzz::meshExtension(in.u8());
   const std::vector<std::size_t>& bodies = linkBodies();
