@@ -69,6 +69,7 @@ class BulletCapeRun final : public SceneRun {
       // crowd's capes more than 8 m out (half CapeActionSettings::frameSpacing) keep frames of their own,
       // which relocating to the origin itself would have dropped, shifting the cape 16 m from its pins.
       cape->relocate(scene_->origin() + cape->frameOrigin());
+      scene_->startCape(k, *cape);
       for (const PinSpec& p : scene_->pins(k)) cape->attach(p.particle, p.body, p.localPivot);
       group_->add(cape.get());
       capes_.push_back(std::move(cape));

@@ -61,13 +61,17 @@ int squareCellRows(int columns, double width, double height) {
   return std::max(2, static_cast<int>(std::lround(static_cast<double>(columns - 1) * height / width)) + 1);
 }
 
-bool BulletScene::makeRig(const CapeSize& fitted, std::string& error) {
+bool BulletScene::makeRig(const CapeSize& fitted, double shoulderSpan, std::string& error) {
   const RunOptions& o = options_;
+  // A gathered collar from shoulder to shoulder, its ends 3 cm forward onto them; the cape as wide as a
+  // corner-pinned one would be (8 cm beyond each shoulder), so gathered onto the collar by about 0.7.
+  collar_.span = static_cast<float>(std::round(std::clamp(shoulderSpan, 0.1, 3.0) * 1000.0) / 1000.0);
+  collar_.wrap = 0.03f;
   settings_ = o.settings;
   const bool bend = o.settings.bendStiffness > 0.0f;
   if (!o.capeWidth && !o.capeHeight && !o.fabric) {
     capeSize_ = fitted;
-    rig_ = makeCapeRig(o.size, o.pinLayout, bend, fitted);
+    rig_ = makeCapeRig(o.size, o.pinLayout, bend, fitted, 0, 0.0f, collar_);
   } else {
     // The pins and the canonical mass per area as makeCapeRig gives them for this size (or the fabric's
     // mass), on a grid of `size` particles across and, with a width or a height, as many rows as keep the
@@ -86,7 +90,7 @@ bool BulletScene::makeRig(const CapeSize& fitted, std::string& error) {
       return false;
     }
     rig_ = makeCapeRig(o.size, o.pinLayout, bend, capeSize_, rows,
-                       o.fabric ? fabricMass(*o.fabric, capeSize_.width, capeSize_.height) : 0.0f);
+                       o.fabric ? fabricMass(*o.fabric, capeSize_.width, capeSize_.height) : 0.0f, collar_);
   }
   if (!rig_.fabric) {
     error = "cannot build a " + std::to_string(o.size) + " particle wide cape";
@@ -156,7 +160,8 @@ bool BulletScene::build(const RunOptions& o, WorldKind kind, std::string& error)
   const int count = o.scene == SceneKind::Crowd ? std::max(1, o.characters) : 1;
   if (o.simpleBody) {
     body_ = "the simple body of docs/SCENES.md as kinematic Bullet bodies";
-    if (!makeRig(CapeSize(), error)) return false;
+    // docs/SCENES.md's shoulder spheres are 0.44 m apart.
+    if (!makeRig(CapeSize(), 0.44, error)) return false;
     for (int k = 0; k < count; ++k) addSimpleCharacter(crowdOffset(k, count));
     if (!o.attachLinks.empty()) warnings_.push_back("--attach is ignored with --simple-body");
   } else {
@@ -247,7 +252,7 @@ void BulletScene::addSimpleCharacter(const Vec3& offset) {
   auto c = std::make_unique<Character>();
   c->offset = offset;
   c->simple = std::make_unique<BulletSimpleBody>(*world_, offset, motionAt(motion_, 0.0));
-  if (options_.pinLayout == PinLayout::Collar) {
+  if (options_.pinLayout != PinLayout::Corners) {
     c->anchors.emplace_back(0.0f, c->simple->rigidBody(SimpleBody::kTorso));
   } else {
     c->anchors.emplace_back(-1.0f, c->simple->rigidBody(SimpleBody::kLeftShoulder));
@@ -343,12 +348,13 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
   }
   c->torsoLink = a.upperTorsoLink;
   std::vector<int> links;
-  if (options_.pinLayout == PinLayout::Collar) {
-    links = {a.upperTorsoLink};
-  } else if (options_.attachLinks.empty()) {
-    links = {a.leftLink, a.rightLink};
-  } else {
+  if (!options_.attachLinks.empty()) {
+    // The links asked for, whatever the layout: each pin goes to the nearest of them along X.
     for (const std::string& name : options_.attachLinks) links.push_back(model_->findLink(name));
+  } else if (options_.pinLayout != PinLayout::Corners) {
+    links = {a.upperTorsoLink};
+  } else {
+    links = {a.leftLink, a.rightLink};
   }
   const Eigen::Matrix3d toScene = character::Skeleton::sceneToWorld(options_.up).transpose();
   for (int link : links) {
@@ -377,7 +383,7 @@ bool BulletScene::addUrdfCharacter(const Vec3& offset, bool first, std::string& 
     size.width = static_cast<float>(std::round(std::clamp(span + 2.0 * 0.08, 0.2, 3.0) * 1000.0) / 1000.0);
     const double pinHeight = 0.5 * (a.left.y() + a.right.y()) + kPinLineAbove;
     size.height = static_cast<float>(std::round(std::clamp(pinHeight - 0.45, 0.2, 1.0) * 1000.0) / 1000.0);
-    if (!makeRig(size, error)) return false;
+    if (!makeRig(size, span, error)) return false;
     size = capeSize_;
     attachDescription_ = a.description;
     char line[160];
@@ -448,6 +454,22 @@ void BulletScene::placeCape(Character& c) {
     }
     const Vec3 at = carried ? (c.carry * toWorld(point).cast<double>()).cast<float>() : toWorld(point);
     c.pins.push_back({rig_.pinnedParticles[p], body, relative.inverse() * toBt(at)});
+  }
+}
+
+void BulletScene::startCape(int character, bullet::CapeAction& action) const {
+  if (options_.pinLayout != PinLayout::Gathered) return;
+  // The grid's rest points gathered onto the collar (gatheredPoint, in the grid's frame), placed as the
+  // cape is (relative to the scene's origin), and written in the cape's frame (in double: the frame may be
+  // far from the world's origin).
+  const Pose& placement = characters_[static_cast<std::size_t>(character)]->placement;
+  const Eigen::Vector3d shift = options_.origin - action.cape().origin();
+  Cape& cape = action.cape();
+  const Points& rest = cape.fabric().restPositions();
+  Points& x = cape.mutableState().positions;
+  for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+    const Vec3 at = placement.apply(gatheredPoint(rest.row(i).transpose(), capeSize_, collar_));
+    x.row(i) = (at.cast<double>() + shift).cast<float>().transpose();
   }
 }
 

@@ -7,6 +7,7 @@
 
 #include "SceneRun.h"
 
+#include "cape/bullet/CapeAction.h"
 #include "cape/character/Anchors.h"
 #include "cape/character/Character.h"
 
@@ -76,6 +77,12 @@ class BulletScene {
   const Eigen::Vector3d& origin() const { return options_.origin; }
   /// The cape's starting placement relative to origin() (world = origin + placement * fabric rest shape).
   Pose capePlacement(int character) const;
+  /// Puts a character's new cape (made at capePlacement and relocated to its frame) in the shape it starts
+  /// in: a gathered cape (PinLayout::Gathered) gathered onto its collar, its top row on the pins; any other
+  /// as it was placed.
+  void startCape(int character, bullet::CapeAction& cape) const;
+  /// The collar a gathered cape hangs from (across the character's shoulder span).
+  const CollarShape& collar() const { return collar_; }
   /// The cape's pins: particles, bodies and body-frame pivots.
   const std::vector<PinSpec>& pins(int character) const;
   /// One line for summary.json: the body, the attachment links, the stepping.
@@ -103,7 +110,8 @@ class BulletScene {
   void placeCape(Character& c);
   /// The cape's rig and size: `fitted` (the canonical size, or the one fitted to the character) unless the
   /// options give a width or a height. False and the reason when no such cape can be built.
-  bool makeRig(const CapeSize& fitted, std::string& error);
+  /// The rig for the fitted size (or the options' size), its collar across `shoulderSpan` (m).
+  bool makeRig(const CapeSize& fitted, double shoulderSpan, std::string& error);
   Vec3 toWorld(const Vec3& scene) const;
   void poseAt(double t);
 
@@ -127,6 +135,7 @@ class BulletScene {
   std::unique_ptr<character::MotionPlayer> player_;  ///< bound to model_ by the first character
   double motionUs_ = 0.0;                            ///< stepFrame's poseAt, µs
   CapeSize capeSize_;
+  CollarShape collar_;
   CapeSettings settings_;
   CapeRig rig_;
   std::vector<std::unique_ptr<Character>> characters_;

@@ -192,11 +192,12 @@ void Renderer::begin(const Camera& camera, const Colour& background, bool lighti
   glMatrixMode(GL_MODELVIEW);
   glLoadMatrixf(camera.view.data());
 
-  // A key light from above and behind the camera's left, a weaker fill from the other side; directions in
-  // the world (set with the view loaded). Both sides of the cape are lit (two-sided lighting).
-  const GLfloat key[4] = {-0.45f, 0.85f, 0.55f, 0.0f}, fill[4] = {0.6f, 0.35f, -0.5f, 0.0f};
-  const GLfloat keyColour[4] = {0.75f, 0.73f, 0.70f, 1.0f}, fillColour[4] = {0.30f, 0.32f, 0.36f, 1.0f};
-  const GLfloat ambient[4] = {0.28f, 0.28f, 0.30f, 1.0f}, black[4] = {0, 0, 0, 1};
+  // A key light low from behind the camera's left, grazing across the cape's back so that its folds (which
+  // run down it) show as light and shade, and a weaker fill from the other side; directions in the world
+  // (set with the view loaded). Both sides of the cape are lit (two-sided lighting).
+  const GLfloat key[4] = {-0.80f, 0.50f, 0.35f, 0.0f}, fill[4] = {0.6f, 0.35f, -0.5f, 0.0f};
+  const GLfloat keyColour[4] = {0.80f, 0.78f, 0.74f, 1.0f}, fillColour[4] = {0.24f, 0.26f, 0.30f, 1.0f};
+  const GLfloat ambient[4] = {0.24f, 0.24f, 0.26f, 1.0f}, black[4] = {0, 0, 0, 1};
   glLightfv(GL_LIGHT0, GL_POSITION, key);
   glLightfv(GL_LIGHT0, GL_DIFFUSE, keyColour);
   glLightfv(GL_LIGHT0, GL_SPECULAR, keyColour);

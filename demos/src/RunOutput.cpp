@@ -9,6 +9,8 @@
 namespace cape::demo {
 
 namespace fs = std::filesystem;
+
+constexpr float kDegrees = 57.29577951f;  ///< degrees per radian
 using nlohmann::json;
 
 namespace {
@@ -138,16 +140,16 @@ RunWriter::RunWriter(const fs::path& dir, bool writeFrames, int characters, bool
   if (!csv_ || (writeColliders_ && !jsonl_)) throw std::runtime_error("cannot write into " + dir_.string());
   csv_ << "frame,time_s,frame_time_us,cape_time_us,max_strain,mean_strain,max_penetration_m,self_"
           "intersections,"
-          "pin_error_m,mean_speed_mps,blow_up,guard_restored\n";
+          "pin_error_m,mean_speed_mps,blow_up,guard_restored,mean_dihedral_deg,dihedral_change_deg\n";
 }
 
 void RunWriter::frame(const FrameRow& r) {
   char line[512];
-  std::snprintf(line, sizeof line, "%" PRId64 ",%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%.5f,%d,%u\n", r.frame,
-                r.time, r.frameTimeUs, r.capeTimeUs, r.metrics.maxStrain, r.metrics.meanStrain,
+  std::snprintf(line, sizeof line, "%" PRId64 ",%.6f,%.2f,%.2f,%.6f,%.6f,%.6f,%d,%.3g,%.5f,%d,%u,%.4f,%.4f\n",
+                r.frame, r.time, r.frameTimeUs, r.capeTimeUs, r.metrics.maxStrain, r.metrics.meanStrain,
                 r.metrics.maxPenetration, r.metrics.selfIntersections, r.metrics.pinError,
-                r.metrics.meanSpeed, r.metrics.blowUp ? 1 : 0,
-                static_cast<unsigned>(r.metrics.guardRestored));
+                r.metrics.meanSpeed, r.metrics.blowUp ? 1 : 0, static_cast<unsigned>(r.metrics.guardRestored),
+                r.metrics.meanDihedral * kDegrees, r.metrics.dihedralChange * kDegrees);
   csv_ << line;
 }
 
@@ -205,6 +207,8 @@ json summaryFigures(const FrameTimings& timings, const RunSummary& q) {
   j["frames_with_self_intersections"] = q.framesWithSelfIntersections;
   j["pin_error_max_m"] = q.pinErrorMax;
   j["rest_jitter_mps"] = q.restJitter;
+  j["mean_dihedral_deg"] = q.meanDihedral * static_cast<double>(kDegrees);
+  j["mean_dihedral_change_deg"] = q.meanDihedralChange * static_cast<double>(kDegrees);
   j["blow_up"] = q.blowUp;
   j["guard_restored_particles"] = q.guardRestored;
   j["frames_guard_restored"] = q.framesGuardRestored;

@@ -44,16 +44,25 @@ void addSceneOptions(CLI::App& app, SceneCli& cli) {
   app.add_option("--fabric", cli.fabric,
                  "a real fabric for the cape: " + fabricNames() +
                      " (its mass per area, stretch, shear and bending stiffness, damping and drag; "
-                     "default: the canonical cape of docs/SCENES.md)")
+                     "default: wool for --cape cape, none for --cape canonical)")
       ->check(CLI::Validator(
           [](std::string& name) {
             return findFabric(name) ? std::string()
                                     : "unknown fabric '" + name + "'; give one of " + fabricNames();
           },
           "NAME"));
-  app.add_option("--attachment", cli.attachment, "corners (the two top corners) | collar (the whole top row)")
-      ->check(CLI::IsMember({"corners", "collar"}))
+  app.add_option("--cape", cli.cape,
+                 "cape: gathered along a collar across the shoulders, of wool, folding as it hangs, with "
+                 "self-collision | "
+                 "canonical: docs/SCENES.md's comparison cape, pinned by its two top corners, with the "
+                 "canonical stiffness (what cape_compare and the benchmarks use); --attachment and --fabric "
+                 "change either")
+      ->check(CLI::IsMember({"cape", "canonical"}))
       ->capture_default_str();
+  app.add_option("--attachment", cli.attachment,
+                 "corners (the two top corners) | collar (the whole top row, straight) | gathered (the whole "
+                 "top row gathered onto a collar from shoulder to shoulder; default: the --cape's)")
+      ->check(CLI::IsMember({"corners", "collar", "gathered"}));
   app.add_option("--seconds", cli.seconds,
                  "simulated length, s, up to 24 h, rounded to whole 1/60 s frames (default: the scene's "
                  "own length)")
@@ -184,11 +193,18 @@ bool toRunOptions(const SceneCli& cli, RunOptions& o, std::string& error) {
     o.playback.loop = !cli.motionOnce;
   }
   parseSceneKind(cli.scene, o.scene);
-  parsePinLayout(cli.attachment, o.pinLayout);
+  // The cape's own attachment and fabric unless asked for others.
+  const bool canonical = cli.cape == "canonical";
+  o.capeStyle = canonical ? "canonical" : "cape";
+  o.pinLayout = canonical ? PinLayout::Corners : PinLayout::Gathered;
+  if (!cli.attachment.empty()) parsePinLayout(cli.attachment, o.pinLayout);
   o.size = cli.size;
   if (cli.width) o.capeWidth = static_cast<float>(*cli.width);
   if (cli.height) o.capeHeight = static_cast<float>(*cli.height);
-  if (!cli.fabric.empty()) o.fabric = findFabric(cli.fabric);  // checked by the option
+  if (!cli.fabric.empty())
+    o.fabric = findFabric(cli.fabric);  // checked by the option
+  else if (!canonical)
+    o.fabric = findFabric("wool");
   o.seconds = cli.seconds;
   o.characters = o.scene == SceneKind::Crowd ? cli.characters : 1;
   o.simpleBody = cli.simpleBody;

@@ -26,7 +26,11 @@ constexpr double kMaxCapeSide = 5.0;  ///< --width, --height, m
 
 struct SceneCli {
   std::string scene = "walk";
-  std::string attachment = "corners";
+  /// The cape: "cape" (gathered along a collar across the shoulders, of wool) or "canonical"
+  /// (docs/SCENES.md's comparison cape: pinned by its corners, the canonical stiffness). The caller sets the
+  /// default.
+  std::string cape = "cape";
+  std::string attachment;  ///< corners | collar | gathered; empty: the cape's own
   std::string urdf;
   std::string attach;                   ///< comma-separated link names
   int size = 20;                        ///< particles per side, or across with --width or --height

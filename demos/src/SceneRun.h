@@ -33,6 +33,9 @@ struct RunOptions {
   /// canonical cape (0.4 kg per 0.6 m^2) with `settings` as they are.
   const FabricMaterial* fabric = nullptr;
   PinLayout pinLayout = PinLayout::Corners;
+  /// The cape asked for (--cape): "canonical" (docs/SCENES.md's: corners, no fabric) or "cape" (gathered,
+  /// wool); pinLayout and fabric hold what it became with --attachment and --fabric.
+  std::string capeStyle = "canonical";
   double seconds = -1.0;  ///< < 0: the scene's own length
   int characters = 1;     ///< crowd size
   int threads = 1;

@@ -106,6 +106,7 @@ class TwinRun {
       // A cape action (never added to the world) places the cape and holds the attachments the twin copies.
       auto proto = std::make_unique<bullet::CapeAction>(scene_->rig().fabric, settings,
                                                         bullet::toBt(scene_->capePlacement(k)));
+      scene_->startCape(k, *proto);
       for (const PinSpec& p : scene_->pins(k)) proto->attach(p.particle, p.body, p.localPivot);
       btSoftBody* body = nullptr;
       if (kind == Kind::SoftBody) {
@@ -228,6 +229,7 @@ int main(int argc, char** argv) {
   bool withDeformable = false;
   double deformableStiffness = 50.0;
   std::string render, renderSize = "960x360";
+  sceneCli.cape = "canonical";  // the comparison's cape (docs/SCENES.md), so figures stay comparable
   addSceneOptions(app, sceneCli);
   app.add_option("--softbody-iterations", iterations, "btSoftBody position iterations (m_cfg.piterations)")
       ->transform(strictInteger(1, 200))

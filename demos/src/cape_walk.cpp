@@ -82,7 +82,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--substeps", substeps, "solver substeps per 1/60 s frame (default: the solver's)")
       ->transform(strictInteger(1, 64));
-  app.add_flag("--self-collision", selfCollision, "keep the cape from passing through itself");
+  bool noSelfCollision = false;
+  app.add_flag("--self-collision", selfCollision,
+               "keep the cape from passing through itself (default: on for --cape cape, off for canonical)");
+  app.add_flag("--no-self-collision", noSelfCollision, "let the cape pass through itself")
+      ->excludes("--self-collision");
   app.add_option("--threads", threads, "worker threads stepping the capes")
       ->transform(strictInteger(1, 256))
       ->capture_default_str();
@@ -128,7 +132,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   const std::string& scene = sceneCli.scene;
-  const std::string& attachment = sceneCli.attachment;
+  const std::string attachment = toString(o.pinLayout);
+  // The explicit solver keeps the seed's springs: the cape's own fabric (wool) gives way to them; a fabric
+  // asked for by name cannot.
+  if (solver == "explicit" && sceneCli.fabric.empty()) o.fabric = nullptr;
   if (solver == "explicit" && o.fabric) {
     std::fprintf(stderr,
                  "cape_walk: --fabric sets the XPBD solver's springs; the explicit solver keeps the seed's "
@@ -146,7 +153,8 @@ int main(int argc, char** argv) {
     o.settings.shearStiffness = 40.0f;
   }
   if (substeps > 0) o.settings.substeps = substeps;
-  o.settings.selfCollision = selfCollision;
+  // The folding cape collides with itself unless told not to; the canonical one only when asked.
+  o.settings.selfCollision = selfCollision || (!noSelfCollision && o.capeStyle == "cape");
   if (Status s = o.settings.validate(); !s.ok()) {
     std::fprintf(stderr, "cape_walk: %s\n", s.message().c_str());
     return 1;
@@ -223,6 +231,7 @@ int main(int argc, char** argv) {
   // The summary, streamed: per character, the worst character's (the table's) and the timings.
   std::vector<MetricsRecorder> recorders(static_cast<std::size_t>(run->characterCount()));
   std::vector<SelfIntersectionCounter> counters(recorders.size());
+  FoldMeter folds;  // the first character's cape (a crowd's others are not measured: it costs per edge)
   MetricsRecorder worst;
   FrameTimings timings;
   std::int64_t framesRun = 0;
@@ -252,6 +261,11 @@ int main(int argc, char** argv) {
       // What the numerical guard restored this frame was a blow-up it kept from lasting.
       m.guardRestored = run->guardRestoredLastFrame(k);
       m.blowUp = m.blowUp || m.guardRestored > 0;
+      if (k == 0 && !m.blowUp) {
+        const FoldStats fold = folds.measure(cape.fabric(), cape.state().positions);
+        m.meanDihedral = fold.meanDihedral;
+        m.dihedralChange = fold.meanChange;
+      }
       recorders[static_cast<std::size_t>(k)].add(m);
       row.metrics = k == 0 ? m : worstOf(row.metrics, m);  // a crowd's row holds the worst of its characters
       // ...the outputs in the scene's.
@@ -325,6 +339,7 @@ int main(int argc, char** argv) {
   nlohmann::json summary;
   summary["scene"] = scene;
   summary["body"] = run->describe();
+  summary["cape_style"] = o.capeStyle;
   summary["attachment"] = attachment;
   summary["characters"] = run->characterCount();
   summary["threads"] = threads;

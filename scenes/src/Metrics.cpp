@@ -476,7 +476,51 @@ FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b) {
   m.meanSpeed = std::max(a.meanSpeed, b.meanSpeed);
   m.guardRestored = std::max(a.guardRestored, b.guardRestored);
   m.blowUp = a.blowUp || b.blowUp;
+  m.meanDihedral = std::max(a.meanDihedral, b.meanDihedral);
+  m.dihedralChange = std::max(a.dihedralChange, b.dihedralChange);
   return m;
+}
+
+FoldStats FoldMeter::measure(const Fabric& fabric, const Points& x) {
+  const std::vector<TriangleLocalSet>& local = fabric.triangleLocal();
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  if (last_.size() != 3 * local.size()) last_.assign(3 * local.size(), none);
+  FoldStats f;
+  if (static_cast<std::size_t>(x.rows()) != fabric.particleCount()) return f;
+  const auto point = [&](std::uint32_t i) { return Vec3(x.row(i).transpose()); };
+  double sum = 0.0, change = 0.0;
+  std::size_t changed = 0;
+  for (std::size_t t = 0; t < local.size(); ++t) {
+    const std::uint32_t* v = local[t].v;
+    const Vec3 a = point(v[0]), b = point(v[1]), c = point(v[2]);
+    const Vec3 n = (b - a).cross(c - a);
+    for (std::size_t k = 0; k < 3; ++k) {
+      float& last = last_[3 * t + k];
+      const std::uint32_t far = v[3 + k];
+      // Each interior edge once: from the triangle that runs along it from the lower index.
+      if (far == ~0u || v[k] > v[(k + 1) % 3]) continue;
+      // Edge k runs from corner k to corner k + 1; across it, the other triangle is (k + 1, k, far),
+      // counter-clockwise like this one.
+      const Vec3 p = point(v[k]), q = point(v[(k + 1) % 3]), r = point(far);
+      const Vec3 m = (p - q).cross(r - q);
+      const float nn = n.norm(), mm = m.norm();
+      if (!(nn > 1e-12f) || !(mm > 1e-12f) || !std::isfinite(nn) || !std::isfinite(mm)) {
+        last = none;
+        continue;
+      }
+      const float angle = std::acos(std::clamp(n.dot(m) / (nn * mm), -1.0f, 1.0f));
+      sum += static_cast<double>(angle);
+      ++f.edges;
+      if (!std::isnan(last)) {
+        change += static_cast<double>(std::fabs(angle - last));
+        ++changed;
+      }
+      last = angle;
+    }
+  }
+  if (f.edges > 0) f.meanDihedral = static_cast<float>(sum / static_cast<double>(f.edges));
+  if (changed > 0) f.meanChange = static_cast<float>(change / static_cast<double>(changed));
+  return f;
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -560,6 +604,8 @@ void MetricsRecorder::add(const FrameMetrics& f) {
   r.guardRestored += f.guardRestored;
   r.framesGuardRestored += f.guardRestored > 0 ? 1 : 0;
   meanStrainSum_ += f.meanStrain;
+  dihedralSum_ += f.meanDihedral;
+  dihedralChangeSum_ += f.dihedralChange;
   frameMaxStrain_.add(f.maxStrain);
   r.maxPenetration = std::max(r.maxPenetration, f.maxPenetration);
   if (f.maxPenetration > 1e-3f) ++r.framesPenetrationOver1mm;
@@ -574,7 +620,11 @@ void MetricsRecorder::add(const FrameMetrics& f) {
 
 RunSummary MetricsRecorder::summary() const {
   RunSummary r = running_;
-  if (r.frames > 0) r.meanStrain = meanStrainSum_ / static_cast<double>(r.frames);
+  if (r.frames > 0) {
+    r.meanStrain = meanStrainSum_ / static_cast<double>(r.frames);
+    r.meanDihedral = dihedralSum_ / static_cast<double>(r.frames);
+    r.meanDihedralChange = dihedralChangeSum_ / static_cast<double>(r.frames);
+  }
   r.medianFrameMaxStrain = static_cast<float>(frameMaxStrain_.percentile(50.0));
   r.p95FrameMaxStrain = static_cast<float>(frameMaxStrain_.percentile(95.0));
   // The last second's mean speeds, oldest first.

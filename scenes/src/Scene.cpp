@@ -68,17 +68,25 @@ bool parseSceneKind(const std::string& name, SceneKind& kind) {
 }
 
 const char* toString(PinLayout layout) {
-  return layout == PinLayout::Corners ? "corners" : "collar";
+  switch (layout) {
+    case PinLayout::Corners:
+      return "corners";
+    case PinLayout::Collar:
+      return "collar";
+    case PinLayout::Gathered:
+      return "gathered";
+  }
+  return "?";
 }
 
 bool parsePinLayout(const std::string& name, PinLayout& layout) {
-  if (name == "corners")
-    layout = PinLayout::Corners;
-  else if (name == "collar")
-    layout = PinLayout::Collar;
-  else
-    return false;
-  return true;
+  for (PinLayout l : {PinLayout::Corners, PinLayout::Collar, PinLayout::Gathered}) {
+    if (name == toString(l)) {
+      layout = l;
+      return true;
+    }
+  }
+  return false;
 }
 
 MotionDesc MotionDesc::forScene(SceneKind kind) {
@@ -193,8 +201,17 @@ void SimpleBody::moveTo(const BodyPose& pose, bool teleport) {
   }
 }
 
+Vec3 gatheredPoint(const Vec3& local, const CapeSize& size, const CollarShape& collar) {
+  const float half = 0.5f * size.width;
+  const float s = (local.x() - half) / half;  // -1 at the left edge, +1 at the right
+  // The collar's arc at the top row, fading out linearly over the first 6 cm below it.
+  const float along = std::clamp(1.0f + local.y() / 0.06f, 0.0f, 1.0f);
+  return Vec3(half + (local.x() - half) * (collar.span / size.width), local.y(),
+              local.z() - along * collar.wrap * s * s);
+}
+
 CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings, const CapeSize& size, int rows,
-                    float totalMass) {
+                    float totalMass, const CollarShape& collar) {
   CapeRig rig;
   const int cols = std::max(n, 2);
   if (layout == PinLayout::Corners) {
@@ -203,9 +220,15 @@ CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings, const CapeSize& s
     for (int c = 0; c < cols; ++c) rig.pinnedParticles.push_back(static_cast<std::uint32_t>(c));
   }
   const float half = 0.5f * size.width;  // the canonical 0.6 gives kPinLine.x() exactly
+  const Pose start = capeStartPlacement(SceneKind::Walk, size);
   for (std::uint32_t p : rig.pinnedParticles) {
     const float u = static_cast<float>(p) / static_cast<float>(cols - 1);
-    rig.pinLocalPoints.emplace_back(-half + u * 2.0f * half, kPinLine.y(), kPinLine.z());
+    if (layout == PinLayout::Gathered) {
+      rig.pinLocalPoints.push_back(
+          start.apply(gatheredPoint(Vec3(u * size.width, 0.0f, 0.0f), size, collar)));
+    } else {
+      rig.pinLocalPoints.emplace_back(-half + u * 2.0f * half, kPinLine.y(), kPinLine.z());
+    }
   }
   GridDesc g;
   g.columns = n;

@@ -11,7 +11,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <string>
+#include <vector>
 
 using namespace capetest;
 using cape::bullet::CapeAction;
@@ -522,6 +525,108 @@ TEST(CapeAction, ZeroAngularInertiaTurnsTheCapeWithItsBody) {
   const btVector3 still = relative(1, false);
   EXPECT_LT((relative(0, true) - still).length(), 1e-3f);
   EXPECT_GT((relative(1, true) - still).length(), 0.05f);
+}
+
+// The speed limits: a body moving at `speed` m/s (or turning at `turn` rad/s) for 0.5 s with the cape's
+// limits set feels as a body moving at the limits does. Returns, after each frame, the middle of the bottom
+// row in the body's frame.
+std::vector<btVector3> limitedPath(btScalar speed, btScalar turn, btScalar maxSpeed, btScalar maxTurn) {
+  World w;
+  btRigidBody* body = w.addKinematic(new btSphereShape(0.05f),
+                                     btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+  cape::bullet::CapeActionSettings s;
+  s.discoverColliders = false;
+  s.maxLinearSpeed = maxSpeed;
+  s.maxAngularSpeed = maxTurn;
+  s.teleportDistance = 1e6f;  // 40 m/s is 0.17 m per step: no teleport, whatever the default
+  s.teleportAngle = 3.0f;
+  CapeAction action(cornerFabric(), cape::CapeSettings(),
+                    btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f)), s);
+  action.attachRow(0, body);
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 60; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  std::vector<btVector3> path;
+  for (int frame = 1; frame <= 30; ++frame) {
+    const btScalar t = btScalar(frame) * kFrame;
+    World::moveKinematic(
+        body, btTransform(btQuaternion(btVector3(0, 1, 0), turn * t), btVector3(-speed * t, 1.5f, 0)));
+    w.world->stepSimulation(kFrame, 8, kFixed);
+    path.push_back(body->getWorldTransform().invXform(action.position(19 * 20 + 10)));
+  }
+  w.world->removeAction(&action);
+  return path;
+}
+
+btScalar largestGap(const std::vector<btVector3>& a, const std::vector<btVector3>& b) {
+  btScalar gap = 0;
+  for (std::size_t k = 0; k < a.size() && k < b.size(); ++k) gap = std::max(gap, (a[k] - b[k]).length());
+  return gap;
+}
+
+TEST(CapeAction, BeyondTheLinearSpeedLimitTheCapeMovesWithItsBody) {
+  // 40 m/s with a 2 m/s limit is, for the cape relative to its body, 2 m/s without a limit; without the
+  // limit the cape trails far behind.
+  const std::vector<btVector3> limited = limitedPath(40, 0, 2, 0), slow = limitedPath(2, 0, 0, 0),
+                               fast = limitedPath(40, 0, 0, 0);
+  std::printf("40 m/s limited to 2 against 2 m/s: %.2e m apart; unlimited: %.3f m\n",
+              double(largestGap(limited, slow)), double(largestGap(fast, slow)));
+  EXPECT_LT(largestGap(limited, slow), 1e-3f);
+  EXPECT_GT(largestGap(fast, slow), 0.1f);
+  // A limit above the motion changes nothing (the same bits as no limit).
+  EXPECT_EQ(largestGap(limitedPath(2, 0, 5, 0), slow), btScalar(0));
+}
+
+TEST(CapeAction, BeyondTheAngularSpeedLimitTheCapeTurnsWithItsBody) {
+  // A spin at 4 pi rad/s (two turns a second) with a limit of 1 rad/s, against a spin at 1 rad/s.
+  const btScalar spin = btScalar(4 * SIMD_PI);
+  const std::vector<btVector3> limited = limitedPath(0, spin, 0, 1), slow = limitedPath(0, 1, 0, 0),
+                               fast = limitedPath(0, spin, 0, 0);
+  std::printf("4 pi rad/s limited to 1 against 1 rad/s: %.2e m apart; unlimited: %.3f m\n",
+              double(largestGap(limited, slow)), double(largestGap(fast, slow)));
+  EXPECT_LT(largestGap(limited, slow), 1e-3f);
+  EXPECT_GT(largestGap(fast, slow), 0.1f);
+  // Not finite or negative: no limit.
+  EXPECT_EQ(largestGap(limitedPath(0, spin, -1, std::numeric_limits<btScalar>::quiet_NaN()), fast),
+            btScalar(0));
+}
+
+TEST(CapeAction, MeshHandsOutTheRenderMeshInTheWorld) {
+  World w;
+  btRigidBody* body = w.addKinematic(new btSphereShape(0.05f),
+                                     btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+  cape::bullet::CapeActionSettings s;
+  s.discoverColliders = false;
+  CapeAction action(cornerFabric(), cape::CapeSettings(),
+                    btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f)), s);
+  action.attachRow(0, body);
+  w.world->addAction(&action);
+  for (int frame = 0; frame < 30; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  const cape::CapeMesh& front = action.mesh();
+  const cape::Fabric& fabric = action.cape().fabric();
+  ASSERT_EQ(front.positions.rows(), static_cast<Eigen::Index>(fabric.particleCount()));
+  EXPECT_EQ(front.positions, action.positions());
+  EXPECT_EQ(front.indices, fabric.triangles());
+  EXPECT_EQ(front.uvs.size(), fabric.particleCount());
+  for (Eigen::Index i = 0; i < front.normals.rows(); ++i)
+    EXPECT_NEAR(front.normals.row(i).norm(), 1.0f, 1e-5f);
+  // Hanging from a row along X, the cape's faces look along Z (their normals mostly +-Z).
+  EXPECT_GT(std::fabs(front.normals.col(2).mean()), 0.8f);
+  // Refreshed in place: the same buffers after more steps, holding the new positions.
+  const float* buffer = front.positions.data();
+  World::moveKinematic(body, btTransform(btQuaternion::getIdentity(), btVector3(0.5f, 1.5f, 0)));
+  for (int frame = 0; frame < 10; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  const cape::CapeMesh& again = action.mesh();
+  EXPECT_EQ(again.positions.data(), buffer);
+  EXPECT_EQ(again.positions, action.positions());
+  // Two-sided: the back copy after the front, its normals flipped.
+  const cape::CapeMesh& both = action.mesh(true);
+  ASSERT_TRUE(both.twoSided());
+  const Eigen::Index n = static_cast<Eigen::Index>(fabric.particleCount());
+  ASSERT_EQ(both.positions.rows(), 2 * n);
+  EXPECT_EQ(both.indices.size(), 2 * fabric.triangles().size());
+  for (Eigen::Index i = 0; i < n; ++i)
+    EXPECT_LT((both.normals.row(i) + both.normals.row(n + i)).norm(), 1e-6f);
+  w.world->removeAction(&action);
 }
 
 TEST(CapeAction, DebugDrawDrawsEveryTriangleEdge) {

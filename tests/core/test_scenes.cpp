@@ -6,11 +6,16 @@
 #include "cape/scenes/Scene.h"
 
 #include <cmath>
+#include <limits>
 
 namespace cape {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+
+float restWidth(const Fabric& f) {
+  return f.restPositions().col(0).maxCoeff();
+}
 
 TEST(Scenes, ParseNames) {
   SceneKind k;
@@ -21,8 +26,11 @@ TEST(Scenes, ParseNames) {
   }
   EXPECT_FALSE(parseSceneKind("dance", k));
   PinLayout a;
-  EXPECT_TRUE(parsePinLayout("collar", a));
-  EXPECT_EQ(a, PinLayout::Collar);
+  for (PinLayout layout : {PinLayout::Corners, PinLayout::Collar, PinLayout::Gathered}) {
+    ASSERT_TRUE(parsePinLayout(toString(layout), a));
+    EXPECT_EQ(a, layout);
+  }
+  EXPECT_STREQ(toString(PinLayout::Gathered), "gathered");
   EXPECT_FALSE(parsePinLayout("belt", a));
 }
 
@@ -84,6 +92,81 @@ TEST(Scenes, CapeRigs) {
   EXPECT_NEAR(corners.pinLocalPoints[0].z(), 0.15f, 1e-6f);
   const CapeRig collar = makeCapeRig(20, PinLayout::Collar);
   EXPECT_EQ(collar.pinnedParticles.size(), 20u);
+}
+
+TEST(Scenes, AGatheredCapeHangsFromAnArcAcrossTheShoulders) {
+  // A 0.6 m cape on a 0.35 m collar whose ends come 5 cm forward: the whole top row pinned, evenly along X
+  // from -0.175 to +0.175, on the parabola z = 0.15 - 0.05 (2x / 0.35)^2 at the pin line's height.
+  CollarShape collar;
+  collar.span = 0.35f;
+  collar.wrap = 0.05f;
+  const CapeRig rig = makeCapeRig(20, PinLayout::Gathered, true, CapeSize(), 0, 0.0f, collar);
+  ASSERT_TRUE(rig.fabric);
+  ASSERT_EQ(rig.pinnedParticles.size(), 20u);
+  EXPECT_NEAR(rig.fabric->totalMass(), 0.4f, 1e-5f);  // the fabric is the canonical one, only gathered
+  for (std::size_t k = 0; k < 20; ++k) {
+    EXPECT_EQ(rig.pinnedParticles[k], k);
+    const Vec3& p = rig.pinLocalPoints[k];
+    const float x = -0.175f + 0.35f * static_cast<float>(k) / 19.0f;
+    EXPECT_NEAR(p.x(), x, 1e-6f);
+    EXPECT_NEAR(p.y(), 1.56f, 1e-6f);
+    EXPECT_NEAR(p.z(), 0.15f - 0.05f * (2.0f * x / 0.35f) * (2.0f * x / 0.35f), 1e-6f);
+  }
+  // The start shape: the top row on the pins, rows below pulled in by span / width and bent back to flat
+  // within 6 cm (the third row, 10.5 cm down, is flat at z = 0.15).
+  const Pose start = capeStartPlacement(SceneKind::Walk);
+  const Points& rest = rig.fabric->restPositions();
+  for (std::size_t k = 0; k < 20; ++k)
+    EXPECT_LT(
+        (start.apply(gatheredPoint(rest.row(k).transpose(), CapeSize(), collar)) - rig.pinLocalPoints[k])
+            .norm(),
+        1e-6f);
+  const Vec3 third = start.apply(gatheredPoint(rest.row(2 * 20 + 19).transpose(), CapeSize(), collar));
+  EXPECT_NEAR(third.x(), 0.175f, 1e-6f);
+  EXPECT_NEAR(third.z(), 0.15f, 1e-6f);
+}
+
+TEST(Metrics, FoldMeterMeasuresDihedralAnglesAndTheirChange) {
+  const CapeRig rig = makeCapeRig(5, PinLayout::Corners);  // 5 x 5: 16 cells, 32 triangles
+  const Fabric& f = *rig.fabric;
+  // Interior edges of 4 x 4 cells, each halved along one diagonal: 3 x 4 + 4 x 3 between cells, one
+  // diagonal in each of the 16 cells.
+  Points x = f.restPositions();
+  FoldMeter meter;
+  FoldStats flat = meter.measure(f, x);
+  EXPECT_EQ(flat.edges, 40u);
+  EXPECT_NEAR(flat.meanDihedral, 0.0f, 1e-3f);
+  EXPECT_EQ(flat.meanChange, 0.0f);  // nothing to compare with yet
+  // Folded by 90 degrees along the middle column (x = half the width): exactly the 4 edges on that line
+  // bend, by pi / 2; every other interior edge stays flat.
+  const float mid = 0.5f * restWidth(f);
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    if (x(i, 0) > mid + 1e-6f) {
+      const float d = x(i, 0) - mid;
+      x(i, 0) = mid;
+      x(i, 2) = d;
+    }
+  }
+  const FoldStats folded = meter.measure(f, x);
+  EXPECT_EQ(folded.edges, 40u);
+  EXPECT_NEAR(folded.meanDihedral, 4.0f * static_cast<float>(kPi / 2) / 40.0f, 1e-4f);
+  EXPECT_NEAR(folded.meanChange, folded.meanDihedral, 1e-4f);  // every change since the flat sheet
+  const FoldStats again = meter.measure(f, x);
+  EXPECT_NEAR(again.meanDihedral, folded.meanDihedral, 1e-6f);
+  EXPECT_EQ(again.meanChange, 0.0f);  // the same shape twice
+  // A rigid motion changes no angle.
+  const Eigen::Matrix3f turn = Eigen::AngleAxisf(0.7f, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  Points moved = (x * turn.transpose()).rowwise() + Eigen::RowVector3f(4, -2, 9);
+  const FoldStats rigid = meter.measure(f, moved);
+  EXPECT_NEAR(rigid.meanDihedral, folded.meanDihedral, 1e-4f);
+  EXPECT_LT(rigid.meanChange, 1e-3f);
+  // A collapsed triangle and a NaN are left out, not propagated.
+  moved.row(0) = moved.row(1);
+  moved(24, 1) = std::numeric_limits<float>::quiet_NaN();
+  const FoldStats broken = meter.measure(f, moved);
+  EXPECT_LT(broken.edges, 40u);
+  EXPECT_TRUE(std::isfinite(broken.meanDihedral));
+  EXPECT_TRUE(std::isfinite(broken.meanChange));
 }
 
 RunSummary runScene(SceneKind kind, int n = 20, double seconds = -1.0,

@@ -221,8 +221,8 @@ json runWalk(const fs::path& dir, const fs::path& urdf, const std::string& extra
              std::string* output = nullptr) {
   const fs::path out = dir / ("run" + std::to_string(std::hash<std::string>()(extra) % 100000));
   const Result r =
-      run(std::string(CAPE_WALK) + " --urdf " + urdf.string() + " --package-path " + dir.string() +
-          " --seconds 4 --no-frames --no-render --out " + out.string() + " " + extra);
+      run(std::string(CAPE_WALK) + " --cape canonical --urdf " + urdf.string() + " --package-path " +
+          dir.string() + " --seconds 4 --no-frames --no-render --out " + out.string() + " " + extra);
   if (output) *output = r.output;
   EXPECT_EQ(r.exitCode, 0) << r.output;
   std::ifstream in(out / "summary.json");
@@ -306,8 +306,8 @@ TEST(AnyHumanoid, MeshLinksAreHullsInCollidersJsonlAndNoParticleIsInsideOne) {
   h.geometry = Geometry::Meshes;
   const fs::path urdf = writeHumanoid(dir, h);
   const fs::path out = dir / "run";
-  const Result r = run(std::string(CAPE_WALK) + " --urdf " + urdf.string() + " --package-path " +
-                       dir.string() + " --seconds 2 --frames --out " + out.string());
+  const Result r = run(std::string(CAPE_WALK) + " --cape canonical --urdf " + urdf.string() +
+                       " --package-path " + dir.string() + " --seconds 2 --frames --out " + out.string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   double closest = -1.0;
   for (int frame = 10; frame <= 120; frame += 10) {
@@ -345,7 +345,7 @@ TEST(AnyHumanoid, ZUpWorldGivesTheSameMetricsAsYUp) {
   std::vector<std::vector<double>> frames[2];
   for (int u = 0; u < 2; ++u) {
     const fs::path out = dir / (u == 0 ? "framesY" : "framesZ");
-    const Result r = run(std::string(CAPE_WALK) + " --urdf " + urdf.string() +
+    const Result r = run(std::string(CAPE_WALK) + " --cape canonical --urdf " + urdf.string() +
                          " --seconds 1 --frames --out " + out.string() + (u == 0 ? " --up y" : " --up z"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     for (const std::string& l : lines(out / "frames" / "00060.obj")) {

@@ -94,7 +94,9 @@ TEST(CapeWalk, ShippedHumanoidByDefault) {
   std::ifstream in(dir / "summary.json");
   const json s = json::parse(in);
   EXPECT_NE(s["body"].get<std::string>().find("humanoid"), std::string::npos) << s["body"];
-  EXPECT_NE(s["body"].get<std::string>().find("left_shoulder"), std::string::npos) << s["body"];
+  // The default cape: gathered along a collar on the upper torso (the shoulders' common ancestor).
+  EXPECT_EQ(s["attachment"], "gathered");
+  EXPECT_NE(s["body"].get<std::string>().find("attached to torso"), std::string::npos) << s["body"];
   // Every collision element of the humanoid is a collider of the metrics and of colliders.jsonl.
   const json first = json::parse(lines(dir / "colliders.jsonl").front());
   EXPECT_GT(first["colliders"].size(), 10u);

@@ -222,8 +222,9 @@ TEST(DefaultRun, CapeCompareWritesIntoRunsToo) {
 // two ends, so the row keeps its rest length; the columns hang with at most a little strain).
 TEST(CapeSize, WidthAndHeightSizeTheCapeWithSquareCells) {
   const fs::path work = freshWorkDir();
-  const Result r =
-      runIn(work, kWalk, "--width 0.8 --height 1.2 --size 9 --seconds 0.05 --frames --no-render --out run");
+  const Result r = runIn(
+      work, kWalk,
+      "--cape canonical --width 0.8 --height 1.2 --size 9 --seconds 0.05 --frames --no-render --out run");
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const json s = summaryOf(work / "run");
   EXPECT_EQ(s["grid"]["columns"].get<int>(), 9);
@@ -243,8 +244,10 @@ TEST(CapeSize, WidthAndHeightSizeTheCapeWithSquareCells) {
   EXPECT_NEAR(distance(v[0], v[8]), 0.8, 0.8 * 0.01) << "the pinned corners are the width apart";
 
   // Only the width: the height stays the humanoid's fitted one, the rows follow it.
-  const Result fitted = runIn(work, kWalk, "--size 9 --seconds 0.05 --no-render --out fitted");
-  const Result wide = runIn(work, kWalk, "--width 1.0 --size 9 --seconds 0.05 --no-render --out wide");
+  const Result fitted =
+      runIn(work, kWalk, "--cape canonical --size 9 --seconds 0.05 --no-render --out fitted");
+  const Result wide =
+      runIn(work, kWalk, "--cape canonical --width 1.0 --size 9 --seconds 0.05 --no-render --out wide");
   ASSERT_EQ(fitted.exitCode, 0) << fitted.output;
   ASSERT_EQ(wide.exitCode, 0) << wide.output;
   const json f = summaryOf(work / "fitted"), w = summaryOf(work / "wide");
@@ -254,8 +257,8 @@ TEST(CapeSize, WidthAndHeightSizeTheCapeWithSquareCells) {
   EXPECT_EQ(w["cape"]["height_m"].get<double>(), height);
   EXPECT_EQ(w["grid"]["rows"].get<int>(), static_cast<int>(std::lround(8.0 * height / 1.0)) + 1);
   // The simple body's canonical cape, twice as long.
-  const Result simple =
-      runIn(work, kWalk, "--simple-body --height 2 --size 7 --seconds 0.05 --no-render --out s");
+  const Result simple = runIn(
+      work, kWalk, "--cape canonical --simple-body --height 2 --size 7 --seconds 0.05 --no-render --out s");
   ASSERT_EQ(simple.exitCode, 0) << simple.output;
   const json t = summaryOf(work / "s");
   EXPECT_NEAR(t["cape"]["width_m"].get<double>(), 0.6, 1e-6);
@@ -300,9 +303,9 @@ TEST(Fabric, APresetSetsTheCapeAndTheSummaryNamesIt) {
   std::map<std::string, json> runs;
   for (const std::string name : {"silk", "denim", ""}) {
     const std::string out = name.empty() ? "none" : name;
-    const Result r =
-        runIn(work, kWalk,
-              (name.empty() ? "" : "--fabric " + name) + " --size 8 --seconds 0.2 --no-render --out " + out);
+    const Result r = runIn(work, kWalk,
+                           "--cape canonical " + (name.empty() ? std::string() : "--fabric " + name) +
+                               " --size 8 --seconds 0.2 --no-render --out " + out);
     ASSERT_EQ(r.exitCode, 0) << name << ":\n" << r.output;
     runs[name] = summaryOf(work / out);
   }

@@ -318,9 +318,9 @@ std::array<double, 2> bodyCentre(const json& line) {
 // colliders' mean along the way the body went.
 json playAndMeasure(const fs::path& dir, const Play& p) {
   const fs::path out = dir / "run";
-  std::string command = std::string(CAPE_WALK) + " --motion " + p.clip.string() + " --self-collision" +
-                        " --seconds " + std::to_string(p.stride->seconds) + " --frames-every 10 --out " +
-                        out.string();
+  std::string command = std::string(CAPE_WALK) + " --cape canonical --motion " + p.clip.string() +
+                        " --self-collision" + " --seconds " + std::to_string(p.stride->seconds) +
+                        " --frames-every 10 --out " + out.string();
   if (!p.urdf.empty()) command += " --urdf " + p.urdf.string() + " " + p.modelOptions;
   const Result r = run(command);
   EXPECT_EQ(r.exitCode, 0) << p.what << "\n" << r.output;
@@ -497,7 +497,7 @@ TEST(MotionClips, AClipThatIsNotACycleIsSaidAndCanBePlayedOnce) {
   clip.times.resize(keep), clip.rootPositions.resize(keep), clip.rootRotations.resize(keep);
   clip.values.resize(keep * clip.joints.size());
   const fs::path file = writeText(dir / "quarter.csv", character::writeMotionCsv(clip));
-  const std::string base = std::string(CAPE_WALK) + " --motion " + file.string() +
+  const std::string base = std::string(CAPE_WALK) + " --cape canonical --motion " + file.string() +
                            " --seconds 2 --frames-every 60 --no-render --out ";
   const Result looped = run(base + (dir / "looped").string());
   ASSERT_EQ(looped.exitCode, 0) << looped.output;

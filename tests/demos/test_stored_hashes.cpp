@@ -1,8 +1,9 @@
 // Stored determinism hashes of the Bullet walk, as cape_walk runs it: the shipped humanoid and the simple
-// body, each a 20 x 20 cape pinned by its corners, stepped by stepSimulation(1/60, 8, 1/240) for 2 s, in the
-// walk and, with self-collision (which the walk never needs), the sprint-turn's first turn. The whole path is
-// in them: the character, the adapter's discovery, pins and collider conversion, and the core step. A change
-// of behaviour on purpose updates the table in the same commit, saying why.
+// body, each wearing the canonical cape (--cape canonical: docs/SCENES.md's 20 x 20 cape pinned by its
+// corners), stepped by stepSimulation(1/60, 8, 1/240) for 2 s, in the walk and, with self-collision (which
+// the walk never needs), the sprint-turn's first turn. The whole path is in them: the character, the
+// adapter's discovery, pins and collider conversion, and the core step. A change of behaviour on purpose
+// updates the table in the same commit, saying why.
 #include "DemoTestSupport.h"
 
 #include <nlohmann/json.hpp>
@@ -20,17 +21,17 @@ struct StoredRun {
 // step on; each is as deterministic as the other.
 #ifdef BT_USE_DOUBLE_PRECISION
 constexpr StoredRun kStored[] = {
-    {"--scene walk", "cc5173037c5536d6"},
-    {"--scene sprint-turn --self-collision", "f6bcd0ad4b84b8bd"},
-    {"--simple-body --scene walk", "0adc094acad3f882"},
-    {"--simple-body --scene sprint-turn --self-collision", "cf09f3471415fdba"},
+    {"--cape canonical --scene walk", "cc5173037c5536d6"},
+    {"--cape canonical --scene sprint-turn --self-collision", "f6bcd0ad4b84b8bd"},
+    {"--cape canonical --simple-body --scene walk", "0adc094acad3f882"},
+    {"--cape canonical --simple-body --scene sprint-turn --self-collision", "cf09f3471415fdba"},
 };
 #else
 constexpr StoredRun kStored[] = {
-    {"--scene walk", "de265d9bc3c1a47d"},
-    {"--scene sprint-turn --self-collision", "31d544c08da546bf"},
-    {"--simple-body --scene walk", "5d2255f589aaba3c"},
-    {"--simple-body --scene sprint-turn --self-collision", "d3fc03695ffbf30b"},
+    {"--cape canonical --scene walk", "de265d9bc3c1a47d"},
+    {"--cape canonical --scene sprint-turn --self-collision", "31d544c08da546bf"},
+    {"--cape canonical --simple-body --scene walk", "5d2255f589aaba3c"},
+    {"--cape canonical --simple-body --scene sprint-turn --self-collision", "d3fc03695ffbf30b"},
 };
 #endif
 

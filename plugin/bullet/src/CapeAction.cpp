@@ -128,6 +128,16 @@ const Points& CapeAction::positions() const {
   return worldPositions_;
 }
 
+const CapeMesh& CapeAction::mesh(bool twoSided) const {
+  if (!ok()) return mesh_;
+  if (!meshAllocated_ || mesh_.twoSided() != twoSided) {
+    mesh_.allocate(cape_.fabric(), twoSided);
+    meshAllocated_ = true;
+  }
+  mesh_.update(cape_.fabric(), positions());
+  return mesh_;
+}
+
 CapeAction::~CapeAction() = default;
 
 void CapeAction::warnOnce(const std::string& key, const std::string& message) {
@@ -486,24 +496,38 @@ void CapeAction::reportGuard() {
                         "; Cape::guard() counts them (said once)");
 }
 
-void CapeAction::applyInertia() {
+void CapeAction::applyInertia(btScalar dt) {
   const btRigidBody* ref = referenceBody();
   Tracked* t = ref != nullptr ? find(ref) : nullptr;
   if (t == nullptr || t->jumped) return;
   const btScalar li = btClamped(settings_.linearInertia, btScalar(0), btScalar(1));
   const btScalar ai = btClamped(settings_.angularInertia, btScalar(0), btScalar(1));
-  if (li >= btScalar(1) && ai >= btScalar(1)) return;
+  const auto limit = [](btScalar v) { return std::isfinite(v) && v > btScalar(0); };
+  const bool linearLimit = limit(settings_.maxLinearSpeed), angularLimit = limit(settings_.maxAngularSpeed);
+  if (li >= btScalar(1) && ai >= btScalar(1) && !linearLimit && !angularLimit) return;
   // Shift the free particles by the part of the body's motion they should not feel: its rotation about its
-  // origin by (1 - angular inertia) of the step's angle, and (1 - linear inertia) of its displacement.
+  // origin by (1 - angular inertia) of the step's angle, and (1 - linear inertia) of its displacement; and
+  // of what they would feel, whatever is beyond the speed limits.
   const btVector3 c0 = t->stepStart.getOrigin(), c1 = t->stepEnd.getOrigin();
   btQuaternion dq = t->stepEnd.getRotation() * t->stepStart.getRotation().inverse();
   if (dq.w() < 0) dq = -dq;
-  const btQuaternion partial = btQuaternion::getIdentity().slerp(dq, btScalar(1) - ai);
+  btScalar carriedTurn = btScalar(1) - ai;  // the fraction of the step's rotation carried
+  if (angularLimit) {
+    const btScalar angle = dq.getAngle(), felt = ai * angle, most = settings_.maxAngularSpeed * dt;
+    if (felt > most && angle > btScalar(0)) carriedTurn = (angle - most) / angle;
+  }
+  btVector3 shiftBt = (btScalar(1) - li) * (c1 - c0);
+  if (linearLimit) {
+    const btVector3 felt = li * (c1 - c0);
+    const btScalar length = felt.length(), most = settings_.maxLinearSpeed * dt;
+    if (length > most) shiftBt = (c1 - c0) - felt * (most / length);
+  }
+  const btQuaternion partial = btQuaternion::getIdentity().slerp(dq, carriedTurn);
   const Quat r(static_cast<float>(partial.w()), static_cast<float>(partial.x()),
                static_cast<float>(partial.y()), static_cast<float>(partial.z()));
   const Eigen::Matrix3f m = r.normalized().toRotationMatrix();
   const Vec3 centre = toVec3(c0);
-  const Vec3 shift = toVec3((btScalar(1) - li) * (c1 - c0));
+  const Vec3 shift = toVec3(shiftBt);
   // Every particle, and where every pin starts this step, moves alike: otherwise the pins would sweep from
   // their old place while the free particles already stand in the new one, and the springs between them
   // would turn the difference into motion.
@@ -627,7 +651,7 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   applyTeleport();
   followReference();
   updatePins();
-  applyInertia();  // after the pins have their new targets: it shifts where they start
+  applyInertia(dt);  // after the pins have their new targets: it shifts where they start
   buildColliders();
   changed_ = false;
   prepareMicroseconds_ =

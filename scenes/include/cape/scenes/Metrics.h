@@ -89,6 +89,30 @@ struct FrameMetrics {
   /// away from the pins). The guard keeps the NaN from lasting; the frame counts as blown up all the same.
   std::uint32_t guardRestored = 0;
   bool blowUp = false;  ///< A coordinate not finite, or a particle beyond isBlownUp()'s radius
+  /// How the cape folds (FoldMeter; 0 unless the caller measures it: measureFrame does not, it has no
+  /// memory of the last frame): the mean dihedral angle over interior edges and its change since the last
+  /// frame, rad.
+  float meanDihedral = 0.0f;
+  float dihedralChange = 0.0f;
+};
+
+/// How a cape folds. For every interior edge (two triangles sharing it) the dihedral angle: the angle
+/// between the two triangles' normals, 0 where the sheet is flat there, pi where it is folded flat onto
+/// itself. And how much each of those angles changed since the last measure: a cape that sways and folds
+/// changes shape from frame to frame; a board only moves. Degenerate or non-finite triangles are left out.
+struct FoldStats {
+  float meanDihedral = 0.0f;  ///< rad, mean over the interior edges measured (each once)
+  float meanChange = 0.0f;    ///< rad, mean over edges measured both times of |angle - last angle| (first: 0)
+  std::size_t edges = 0;      ///< interior edges measured
+};
+/// Measures FoldStats frame after frame, keeping each edge's last angle (sized on the first measure).
+class CAPE_SCENES_API FoldMeter {
+ public:
+  /// The fold statistics of `positions` (one row per particle of `fabric`), against the last call's.
+  FoldStats measure(const Fabric& fabric, const Points& positions);
+
+ private:
+  std::vector<float> last_;  ///< per triangle edge slot (3 t + k): the last angle, NaN if not measured
 };
 
 /// Measures a frame of any solver's cloth on `fabric` (ours, or a Bullet twin copied into these arrays), so
@@ -127,6 +151,8 @@ struct RunSummary {
   std::int64_t framesGuardRestored = 0;          ///< frames in which it restored any
   bool blowUp = false;                           ///< Any frame blew up
   float restJitter = 0.0f;                       ///< mean particle speed over the last second, m/s
+  double meanDihedral = 0.0;                     ///< rad, mean over frames of FrameMetrics::meanDihedral
+  double meanDihedralChange = 0.0;  ///< rad per frame, mean over frames of FrameMetrics::dihedralChange
 };
 
 /// Nearest-rank percentiles of a stream of values in bounded memory (about 110 KB, allocated up front,
@@ -180,6 +206,7 @@ class CAPE_SCENES_API MetricsRecorder {
  private:
   RunSummary running_;  ///< the extrema and counts so far
   double meanStrainSum_ = 0.0;
+  double dihedralSum_ = 0.0, dihedralChangeSum_ = 0.0;
   PercentileEstimator frameMaxStrain_;
   std::vector<float> lastSpeeds_;  ///< ring of the last second's frames' mean speeds
   std::size_t nextSpeed_ = 0;      ///< where the next one goes (the oldest once the ring is full)

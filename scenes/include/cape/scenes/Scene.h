@@ -24,14 +24,17 @@ CAPE_SCENES_API const char* toString(SceneKind kind);
 /// Parses "hang", "walk", "sprint-turn", "wind", "crowd"; false if unknown.
 CAPE_SCENES_API bool parseSceneKind(const std::string& name, SceneKind& kind);
 
-/// Which cape particles are pinned (docs/SCENES.md's attachment): the two top corners, or the whole top row.
+/// Which cape particles are pinned (docs/SCENES.md's attachment): the two top corners, or the whole top row
+/// along the pin line, or the whole top row gathered onto a collar (a cape as tailors make one: wider than
+/// the shoulders it hangs from, so that it falls in folds).
 enum class PinLayout : int {
-  Corners,  ///< The two top corners.
-  Collar,   ///< Every particle of the top row.
+  Corners,   ///< The two top corners.
+  Collar,    ///< Every particle of the top row, along the straight pin line.
+  Gathered,  ///< Every particle of the top row, gathered onto a CollarShape across the shoulders.
 };
-/// The layout's name: "corners" or "collar".
+/// The layout's name: "corners", "collar" or "gathered".
 CAPE_SCENES_API const char* toString(PinLayout layout);
-/// Parses "corners", "collar"; false if unknown.
+/// Parses "corners", "collar", "gathered"; false if unknown.
 CAPE_SCENES_API bool parsePinLayout(const std::string& name, PinLayout& layout);
 
 /// How the character moves in a scene. Times in s, lengths in m, angles in rad.
@@ -94,24 +97,42 @@ class CAPE_SCENES_API SimpleBody {
   Vec3 offset_;  ///< Where the character stands in the world (crowd members are side by side).
 };
 
-/// Character-frame attachment points: "corners" pins the top corners at (+-0.30, 1.56, 0.15); "collar" pins
-/// the whole top row along the same line.
-struct CapeRig {
-  FabricPtr fabric;                            ///< The cape's fabric, with tethers to the pinned particles
-  std::vector<std::uint32_t> pinnedParticles;  ///< Fabric particle indices
-  std::vector<Vec3> pinLocalPoints;            ///< in the character frame, m
-};
 /// A cape's size, m: the canonical 0.6 x 1.0 (docs/SCENES.md), or one fitted to a character.
 struct CapeSize {
   float width = 0.6f;   ///< m, along the top row
   float height = 1.0f;  ///< m, from the top row down
 };
+
+/// The collar a gathered cape (PinLayout::Gathered) is sewn onto, in the character frame: an arc across the
+/// shoulders through the pin line's middle (0, 1.56, 0.15), `span` from end to end along X, its ends `wrap`
+/// forward (towards -Z, round the neck onto the shoulders): z = 0.15 - wrap (2x / span)^2. The top row's
+/// particles sit on it evenly in X, so a cape wider than the span is gathered by span / width.
+struct CollarShape {
+  float span = 0.44f;  ///< m, end to end along X (> 0): the canonical body's shoulders are 0.44 m apart
+  float wrap = 0.03f;  ///< m, >= 0
+};
+
+/// Where a point of a width x height grid (its local frame: x from 0 to width along the top row, y from 0
+/// down to -height, z out of its back) starts when the cape is gathered onto `collar`, in the same frame: x
+/// pulled towards the middle by span / width, and the top rows bent along the collar's arc (fully at the
+/// top, fading out over 6 cm down the cape). capeStartPlacement maps it into the character frame; the top
+/// row's images are the pins of makeCapeRig's Gathered layout.
+CAPE_SCENES_API Vec3 gatheredPoint(const Vec3& local, const CapeSize& size, const CollarShape& collar);
+
+/// Character-frame attachment points: "corners" pins the top corners at (+-0.30, 1.56, 0.15); "collar" pins
+/// the whole top row along the same line; "gathered" pins the whole top row on `collar` (gatheredPoint).
+struct CapeRig {
+  FabricPtr fabric;                            ///< The cape's fabric, with tethers to the pinned particles
+  std::vector<std::uint32_t> pinnedParticles;  ///< Fabric particle indices
+  std::vector<Vec3> pinLocalPoints;            ///< in the character frame, m
+};
 /// The N x N cape (the canonical 0.6 m x 1.0 m, 0.4 kg; another size keeps its mass per area) with tethers
 /// to its attachment particles, its top row centred on the canonical pin line. `rows` > 0 gives it that many
 /// rows instead of N (N stays the particles across); `totalMass` > 0 (kg) replaces the canonical mass per
-/// area (e.g. a fabric preset's, cape::fabricMass).
+/// area (e.g. a fabric preset's, cape::fabricMass). `collar` is read by the Gathered layout only.
 CAPE_SCENES_API CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings = true,
-                                    const CapeSize& size = CapeSize(), int rows = 0, float totalMass = 0.0f);
+                                    const CapeSize& size = CapeSize(), int rows = 0, float totalMass = 0.0f,
+                                    const CollarShape& collar = CollarShape());
 /// The cape's starting placement in the character frame: flat and vertical at z = 0.15 with its top row on
 /// the pins, or for "hang" flat and horizontal reaching from the pins towards +Z.
 CAPE_SCENES_API Pose capeStartPlacement(SceneKind kind, const CapeSize& size = CapeSize());

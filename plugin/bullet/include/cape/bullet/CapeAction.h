@@ -28,6 +28,7 @@
 #include "cape/bullet/Export.h"
 #include "cape/bullet/ShapeColliders.h"
 #include "cape/core/Cape.h"
+#include "cape/core/CapeMesh.h"
 
 #include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
 #include <BulletDynamics/Dynamics/btActionInterface.h>
@@ -68,6 +69,14 @@ struct CapeActionSettings {
   /// its rotation about its origin (angular) over the step; velocities turn with that rotation.
   btScalar linearInertia = btScalar(1);
   btScalar angularInertia = btScalar(1);  ///< 0..1: the same for the body's rotation (see linearInertia).
+
+  /// Speed limits (as Magica Cloth 2's and Chaos Cloth's): of the reference body's motion the cape feels
+  /// (after the inertia above), no more than maxLinearSpeed (m/s) of travel and maxAngularSpeed (rad/s; 360
+  /// degrees per second is 2 pi) of turn; the rest moves the cape along with the body, as an inertia of 0
+  /// would. So a character dashing at 30 m/s or spinning on the spot drags its cape no harder than one moving
+  /// at the limits. 0 (the default), negative or not finite: no limit.
+  btScalar maxLinearSpeed = btScalar(0);
+  btScalar maxAngularSpeed = btScalar(0);  ///< rad/s (see maxLinearSpeed)
 
   /// A reference body moving farther than this in one step (m), or turning more than teleportAngle (rad),
   /// teleports: the whole cape is moved rigidly with it (Cape::teleport) and no collider is swept.
@@ -207,6 +216,12 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   void relocate(const Eigen::Vector3d& origin);
   /// One particle's position, m, world ((0, 0, 0) for an index out of range).
   btVector3 position(std::uint32_t particle) const;
+  /// The render mesh of the cape as it is now, in the world: positions (as positions()), area-weighted
+  /// vertex normals, the fabric's UVs and its counter-clockwise triangles; `twoSided` adds a back copy
+  /// (flipped winding and normals) for renderers without two-sided shading. Refreshed on each call; its
+  /// buffers are allocated on the first call (and again only when `twoSided` changes), never after. The
+  /// reference stays valid until the next call or the action's end.
+  const CapeMesh& mesh(bool twoSided = false) const;
   /// Wall time of the cape's own work in the last internal step (prepare() and advance()), microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
   /// Sum of lastStepMicroseconds() over the internal steps since the last call of this function (a frame's
@@ -251,7 +266,7 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   bool resting() const;
   void advancePoses(btScalar dt);
   void applyTeleport();
-  void applyInertia();
+  void applyInertia(btScalar dt);
   void updatePins();
   void buildColliders();
   void gatherTriangles(const btConcaveShape* shape, const btTransform& start, const btTransform& end,
@@ -293,6 +308,8 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
 
   bool teleported_ = false;
   mutable Points worldPositions_;  ///< positions() when the frame is away from the world's origin.
+  mutable CapeMesh mesh_;          ///< mesh()'s buffers.
+  mutable bool meshAllocated_ = false;
   std::uint64_t guardReported_ = 0;
   std::uint64_t stepCount_ = 0;
   double lastStepMicroseconds_ = 0.0;
