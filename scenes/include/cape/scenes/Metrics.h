@@ -90,9 +90,9 @@ struct FrameMetrics {
   std::uint32_t guardRestored = 0;
   bool blowUp = false;  ///< A coordinate not finite, or a particle beyond isBlownUp()'s radius
   /// How the cape folds (FoldMeter; 0 unless the caller measures it: measureFrame does not, it has no
-  /// memory of the last frame): the mean dihedral angle over interior edges and its change since the last
-  /// frame, rad.
+  /// memory of the last frame): the mean dihedral angle over interior edges, rad.
   float meanDihedral = 0.0f;
+  /// The mean change of those angles since the last frame, rad (FoldMeter; 0 unless measured).
   float dihedralChange = 0.0f;
 };
 
