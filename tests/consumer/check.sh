@@ -30,7 +30,10 @@ if [ -e "$work/cmake/cape_bullet_consumer" ]; then
 fi
 if [ "$kind" = shared ]; then
   # A shared build: the programs load the installed libraries, not static copies of them.
-  ldd "$work/cmake/cape_consumer" | grep -q "libcape_core.so" || { echo "cape_consumer does not load libcape_core.so"; exit 1; }
+  # (ldd's whole output first: `ldd | grep -q` under pipefail fails whenever grep stops reading early and ldd
+  # gets SIGPIPE, which happened in CI.)
+  loads="$(ldd "$work/cmake/cape_consumer")"
+  grep -q "libcape_core.so" <<<"$loads" || { echo "cape_consumer does not load libcape_core.so:"; echo "$loads"; exit 1; }
 fi
 
 echo "-- version requests the package must refuse"
