@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <set>
@@ -326,6 +327,35 @@ TEST_P(SelfCollisionScenes, ZeroSelfIntersectionsInEveryFrame) {
   EXPECT_EQ(sum.framesPenetrationOver1mm, 0);
 }
 
+/// The most self-contacts any particle has in the last search.
+std::size_t mostContactsOfOneParticle(const Cape& cape) {
+  std::vector<std::size_t> count(static_cast<std::size_t>(cape.state().positions.rows()), 0);
+  std::size_t most = 0;
+  for (const Cape::SelfContact& k : cape.selfContacts()) most = std::max(most, ++count[k.particle]);
+  return most;
+}
+
+// The bound on contacts per particle (Cape::kMaxSelfContactsPerParticle) changes nothing in a cape's scenes:
+// no particle comes near it, with the canonical corners or gathered onto a collar (where the folds crowd).
+TEST_P(SelfCollisionScenes, NoParticleComesNearTheBoundOnContacts) {
+  for (PinLayout layout : {PinLayout::Corners, PinLayout::Gathered}) {
+    CapeSettings s;
+    s.selfCollision = true;
+    SimpleScene scene(GetParam(), 20, layout, s);
+    ASSERT_TRUE(scene.status().ok());
+    std::size_t most = 0;
+    const int frames = static_cast<int>(std::lround(scene.motion().duration * 60.0));
+    for (int f = 0; f < frames; ++f) {
+      scene.advanceFrame();
+      most = std::max(most, mostContactsOfOneParticle(scene.cape()));
+    }
+    EXPECT_LE(2 * most, Cape::kMaxSelfContactsPerParticle)
+        << (layout == PinLayout::Corners ? "corners" : "gathered");
+    std::printf("%s, %s: at most %zu self-contacts of one particle\n", toString(GetParam()),
+                layout == PinLayout::Corners ? "corners" : "gathered", most);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(SelfCollision, SelfCollisionScenes,
                          ::testing::Values(SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn,
                                            SceneKind::Wind),
@@ -334,6 +364,62 @@ INSTANTIATE_TEST_SUITE_P(SelfCollision, SelfCollisionScenes,
                            name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
                            return name;
                          });
+
+/// A side x side sheet, 0.6 x 1 m, and one long triangle per vertex, from it across the sheet to the two
+/// particles half the grid away (tests/fuzz/corpus.cpp's denseFabric, issue 14's hang): the long edges make
+/// the mean spacing, and so the automatic thickness, about as long as the sheet.
+FabricPtr denseFabric(int side) {
+  MeshDesc d;
+  const int n = side * side;
+  for (int r = 0; r < side; ++r)
+    for (int c = 0; c < side; ++c)
+      d.positions.emplace_back(0.6f * static_cast<float>(c) / static_cast<float>(side - 1),
+                               1.5f - static_cast<float>(r) / static_cast<float>(side - 1), 0.0f);
+  for (int r = 0; r + 1 < side; ++r)
+    for (int c = 0; c + 1 < side; ++c) {
+      const int p = r * side + c;
+      for (int v : {p, p + side, p + 1, p + 1, p + side, p + side + 1})
+        d.triangles.push_back(static_cast<std::uint32_t>(v));
+    }
+  for (int v = 0; v < n; ++v)
+    for (int k : {v, (v + n / 2) % n, (v + n / 2 + side) % n})
+      d.triangles.push_back(static_cast<std::uint32_t>(k));
+  d.totalMass = 0.4f;
+  FabricResult made = Fabric::fromMesh(d);
+  EXPECT_TRUE(made) << made.status.message();
+  return made.fabric;
+}
+
+// Every particle within the thickness of nearly every triangle: a search keeps the first
+// Cape::kMaxSelfContactsPerParticle of each particle, so the contacts grow with the particles, not with
+// particles x triangles (32 x 32 made 2.95 million contacts and took 10 s for two frames), and the cape stays
+// finite.
+TEST(SelfCollision, AMeshWhoseThicknessReachesEveryTriangleKeepsTheBoundPerParticle) {
+  for (int side : {12, 32}) {
+    FabricPtr fabric = denseFabric(side);
+    ASSERT_TRUE(fabric);
+    const std::size_t n = fabric->particleCount();
+    CapeSettings s;
+    s.selfCollision = true;
+    // As thick as the fuzz input's automatic thickness made it: every particle within reach of nearly every
+    // triangle of the 0.6 x 1 m sheet.
+    s.selfCollisionThickness = 0.6f;
+    Cape cape(fabric, s);
+    ASSERT_TRUE(cape.ok());
+    cape.pin(0, test::row(cape.state().positions, 0));
+    cape.pin(static_cast<std::uint32_t>(side - 1), test::row(cape.state().positions, side - 1));
+    std::size_t largest = 0;
+    for (int f = 0; f < 2; ++f) {
+      cape.step(1.0f / 60.0f, {});
+      largest = std::max(largest, cape.selfContactCount());
+      EXPECT_LE(mostContactsOfOneParticle(cape), Cape::kMaxSelfContactsPerParticle);
+      EXPECT_TRUE(cape.state().positions.allFinite());
+    }
+    // Many particles do reach the bound: without it they would have more.
+    EXPECT_GT(largest, n * Cape::kMaxSelfContactsPerParticle / 2) << side;
+    EXPECT_LE(largest, n * Cape::kMaxSelfContactsPerParticle) << side;
+  }
+}
 
 }  // namespace
 }  // namespace cape

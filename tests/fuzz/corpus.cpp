@@ -5,7 +5,8 @@
 //                        DeepMimic, BVH; good and broken), each in its target's input
 //                        format (the comment at the top of each fuzz_<target>.cpp);
 //   OUT/large/<target>/  regression inputs too large to commit (issue 14: 40,000 and 100,000 nested
-//                        elements, a 30,000-link chain), generated the same every time.
+//                        elements, a 30,000-link chain, fabrics whose every particle meets every
+//                        triangle), generated the same every time.
 // Usage: cape_fuzz_corpus MODELS_DIR OUT
 #include <algorithm>
 #include <array>
@@ -323,6 +324,34 @@ std::string gridFabric(int flags, int columns, int rows, int anchors, int frames
   return f.bytes;
 }
 
+// Issue 14: a side x side grid (self-collision on, 2 frames) and one long triangle per vertex, from it across
+// the sheet to the two particles half the grid away. The long edges make the mean spacing, and with it the
+// automatic self-collision thickness, about as long as the sheet, so every particle is within reach of every
+// triangle: before self-contacts were bounded per particle, 32 x 32 took 10 s (2.95 million contacts).
+std::string denseFabric(int side) {
+  FabricInput f;
+  for (int v : {1 | 8, 26, 0, 1, 64, 1}) f.u8(v);
+  const int n = side * side, grid = 2 * (side - 1) * (side - 1);
+  f.u16(n - 3);
+  f.u16(grid + n);
+  for (int r = 0; r < side; ++r)
+    for (int c = 0; c < side; ++c) {
+      f.metres(0.6f * static_cast<float>(c) / static_cast<float>(side - 1));
+      f.metres(1.5f - 1.0f * static_cast<float>(r) / static_cast<float>(side - 1));
+      f.metres(0.0f);
+    }
+  for (int r = 0; r + 1 < side; ++r)
+    for (int c = 0; c + 1 < side; ++c) {
+      const int p = r * side + c;
+      for (int v : {p, p + side, p + 1, p + 1, p + side, p + side + 1}) f.u16(v);
+    }
+  for (int v = 0; v < n; ++v)
+    for (int k : {v, (v + n / 2) % n, (v + n / 2 + side) % n}) f.u16(k);
+  for (int k = 0; k < 2; ++k)
+    for (int c : {k * 3, 0, 0, 0, 0, -8}) f.u16(c);  // pins along x, the sphere through the cape
+  return f.bytes;
+}
+
 void fabricSeeds(const fs::path& out) {
   write(out, "quad.bin", gridFabric(1, 2, 2, 2, 2));
   write(out, "grid_6x6_pinned.bin", gridFabric(1 | 4, 6, 6, 3, 4));
@@ -509,6 +538,9 @@ int main(int argc, char** argv) {
   write(out / "large" / "urdf", "nested_100000.urdf", nested(100000));
   // Issue 14, 2: the joint-cycle check walked to the root from every link (30k links: minutes).
   write(out / "large" / "urdf", "chain_30000.urdf", chain(30000));
+  // Issue 14: self-contacts of every particle with every triangle (a 24 KB input: made, not kept).
+  write(out / "large" / "fabric", "dense_self_contacts_32x32.bin", denseFabric(32));
+  write(out / "large" / "fabric", "dense_self_contacts_24x24.bin", denseFabric(24));
   std::printf("wrote the seeds and the large regression inputs under %s\n", out.string().c_str());
   return 0;
 }

@@ -59,6 +59,13 @@ constexpr float kFaceMargin = 0.25f;
 /// frame after).
 constexpr float kMaxCornerAmplification = 2.0f;
 
+/// The most self-contacts one search keeps for a particle (Cape::kMaxSelfContactsPerParticle; its scan stops
+/// there). Without a bound a mesh of a few long triangles, whose mean spacing (and so the automatic
+/// thickness) is as long as the sheet, paired every particle with every triangle: a 1,024-particle fabric of
+/// 32 x 32 and one long triangle per vertex made 2.95 million contacts and took 10 s for two frames (issue
+/// 14).
+constexpr std::size_t kMaxContactsPerParticle = Cape::kMaxSelfContactsPerParticle;
+
 inline bool overFace(float wa, float wb, float wc) {
   return wa >= -kFaceMargin && wb >= -kFaceMargin && wc >= -kFaceMargin;
 }
@@ -267,6 +274,10 @@ float SelfCollision::predictMotion(const CapeState& state, const Eigen::VectorXf
   return stepMotionNorm_.maxCoeff();
 }
 
+CAPE_ALWAYS_INLINE inline bool SelfCollision::particleFull() const {
+  return contacts_.size() - particleFirst_ >= kMaxContactsPerParticle;
+}
+
 void SelfCollision::grownBox(std::uint32_t t, Vec3& lo, Vec3& hi) const {
   // A triangle's box grown by the thickness, the slack and its motion (as binned, and for the rare unbinned
   // paths).
@@ -283,6 +294,7 @@ CAPE_ALWAYS_INLINE inline void SelfCollision::consider(std::uint32_t q, const Ve
   // One particle against one triangle whose grown box its motion's box overlaps: the exact filter, and the
   // contact with the side it is on.
   if (isLocal(fabric_.triangleLocal()[t], q)) return;
+  if (particleFull()) return;
   if (stamp) {
     if (triangleStamp_[t] == q) return;  // met already through another cell
     triangleStamp_[t] = q;
@@ -336,12 +348,13 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
   const std::size_t triangles = fabric_.triangleCount();
   for (Eigen::Index qi = 0; qi < x.rows(); ++qi) {
     const std::uint32_t q = static_cast<std::uint32_t>(qi);
+    particleFirst_ = contacts_.size();
     const Vec3 p = at(x, q);
     const float mq = stepMotionNorm_[qi];
     const float qlo[3] = {p.x() - mq, p.y() - mq, p.z() - mq}, qhi[3] = {p.x() + mq, p.y() + mq, p.z() + mq};
     int range[8];
     if (!cellsOf(invCell_, qlo[0], qlo[1], qlo[2], qhi[0], qhi[1], qhi[2], range)) {
-      for (std::size_t t = 0; t < triangles; ++t) {
+      for (std::size_t t = 0; t < triangles && !particleFull(); ++t) {
         Vec3 tlo, thi;
         grownBox(static_cast<std::uint32_t>(t), tlo, thi);
         if (boxesOverlap(qlo, qhi, tlo.data(), thi.data()))
@@ -356,6 +369,7 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
         for (int iz = range[2]; iz <= range[6]; ++iz)
           scanBucket(q, p, qlo, qhi, bucketOf(ix, iy, iz, mask_), stamp);
     for (const std::uint32_t t : largeTriangles_) {
+      if (particleFull()) break;
       Vec3 tlo, thi;
       grownBox(t, tlo, thi);
       if (boxesOverlap(qlo, qhi, tlo.data(), thi.data())) consider(q, p, t, false);
@@ -434,6 +448,7 @@ void SelfCollision::scanBucket(std::uint32_t q, const Vec3& p, const float* qlo,
   // The bucket's overlapping entries first, without a branch per entry (about one in four overlaps: too many
   // for branches to predict), then the exact tests. The clusters the particle is a corner of overlap it but
   // hold nothing for it (95 % of what overlaps, on a walking cape): one compare passes each over.
+  if (particleFull()) return;
   const HashEntry* entry = hashEntries_.data() + hashStart_[bucket];
   const std::uint32_t count = hashStart_[bucket + 1] - hashStart_[bucket];
   std::uint32_t* found = bucketHits_.data();
@@ -455,7 +470,7 @@ void SelfCollision::scanBucket(std::uint32_t q, const Vec3& p, const float* qlo,
 #endif
   }
   const std::vector<std::uint32_t>& clusterStart = fabric_.clusterStart();
-  for (std::uint32_t k = 0; k < hits; ++k) {
+  for (std::uint32_t k = 0; k < hits && !particleFull(); ++k) {
     const std::uint32_t g = bitsIndex(entry[found[k]].lo[3]);
     const std::uint32_t* l = fabric_.clusterLocal()[g].v;
 #if defined(__SSE2__)

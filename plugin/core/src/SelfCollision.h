@@ -43,6 +43,8 @@ class SelfCollision {
   /// Particle q against triangle t: the exact filter, and the contact if within reach.
   void consider(std::uint32_t q, const Vec3& p, std::uint32_t t, bool stamp);
   void grownBox(std::uint32_t t, Vec3& lo, Vec3& hi) const;
+  /// Whether the particle being scanned has as many contacts as a search keeps for one.
+  bool particleFull() const;
 
   const Fabric& fabric_;
   std::vector<Cape::SelfContact> contacts_;
@@ -75,6 +77,7 @@ class SelfCollision {
   float slack_ = 0.0f;
   float invCell_ = 0.0f;
   std::uint32_t mask_ = 0;
+  std::size_t particleFirst_ = 0;  ///< The scanned particle's first contact in contacts_.
 };
 
 }  // namespace cape::detail

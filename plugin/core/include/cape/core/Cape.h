@@ -11,6 +11,7 @@
 #include "cape/core/Fabric.h"
 
 #include <array>
+#include <cstddef>
 #include <memory>
 #include <vector>
 
@@ -163,6 +164,12 @@ class CAPE_CORE_API Cape {
     std::uint32_t triangle;  ///< Triangle t: corners Fabric::triangles()[3t .. 3t + 2].
     float side;              ///< +1, -1 or 0 (see above).
   };
+  /// The most self-contacts a search keeps for one particle: the first found, in the search's deterministic
+  /// order. A cape's particle meets the few triangles of each layer within reach, well under half of it (a
+  /// test holds every canonical scene to that); the bound keeps a mesh whose long triangles make the
+  /// automatic thickness as long as the sheet (every particle within reach of every triangle) linear in its
+  /// particles, where it was their product.
+  static constexpr std::size_t kMaxSelfContactsPerParticle = 128;
   /// Self-contacts found by the last search (diagnostics, benchmarks and tests).
   const std::vector<SelfContact>& selfContacts() const;
   /// The number of self-contacts found by the last search.
