@@ -23,10 +23,10 @@ struct StoredScene {
 constexpr StoredScene kStored[] = {
     {SceneKind::Hang, false, 0x36e983342aa5d54bull},
     {SceneKind::Hang, true, 0x36e983342aa5d54bull},
-    {SceneKind::Walk, false, 0xe42e25e81ef47c26ull},
-    {SceneKind::Walk, true, 0xe42e25e81ef47c26ull},
-    {SceneKind::SprintTurn, false, 0xe4943c86c51ce854ull},
-    {SceneKind::SprintTurn, true, 0xd29ff20f3bcb0175ull},
+    {SceneKind::Walk, false, 0x5faab71c43d1e6baull},
+    {SceneKind::Walk, true, 0x5faab71c43d1e6baull},
+    {SceneKind::SprintTurn, false, 0xa2b1ed84dc23402aull},
+    {SceneKind::SprintTurn, true, 0x7f9634af2be8b8d2ull},
     {SceneKind::Wind, false, 0x7132717a08c6698aull},
     {SceneKind::Wind, true, 0x6fafb93a52a5ffc7ull},
 };

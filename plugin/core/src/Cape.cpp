@@ -464,11 +464,14 @@ void Cape::adaptRefinement() {
 }
 
 void Cape::movePinsTo(float s, float h) {
+  // A pinned particle's velocity is its move over the substep, from where the substep started
+  // (startPositions) to the target: the prediction has already carried it by h v, and the move left after
+  // that would alternate between u and 0 for a pin moving at a constant u.
   const float invH = 1.0f / h;
   for (const Pin& p : state_.pins) {
     const Vec3 target = p.previousTarget + s * (p.target - p.previousTarget);
     const Eigen::Index i = p.particle;
-    state_.velocities.row(i) = (target.transpose() - state_.positions.row(i)) * invH;
+    state_.velocities.row(i) = (target.transpose() - work_->startPositions.row(i)) * invH;
     state_.positions.row(i) = target.transpose();
   }
 }

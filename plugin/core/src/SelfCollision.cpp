@@ -185,8 +185,10 @@ float SelfCollision::thickness(const CapeSettings& settings) const {
 int SelfCollision::schedule(const CapeState& state, const Eigen::VectorXf& freeMask,
                             const CapeSettings& settings, float dt, int substeps) {
   // Self-contacts are found from where the cape is now and kept through the substeps. One search covers at
-  // most a spacing of motion (relative to the cape's rigid motion) and at most one settings.timeStep. A
-  // calm cape (no particle faster than a spacing per timeStep) searches once per timeStep: a world stepping
+  // most three quarters of a spacing of motion (relative to the cape's rigid motion) and at most one
+  // settings.timeStep: the motion is predicted from the velocities, and the springs change it within the
+  // window (with a whole spacing, and the pins' velocities right, the sprint-turn let two pairs through).
+  // A calm cape (no particle faster than that per timeStep) searches once per timeStep: a world stepping
   // at 1/240 s then searches once per 1/60 s, with that 1/60 s's motion bound. A faster one searches again
   // every few substeps: a search over a whole fast frame would pair every particle with every triangle it
   // might sweep past, and the substeps would carry thousands of contacts.
@@ -194,7 +196,7 @@ int SelfCollision::schedule(const CapeState& state, const Eigen::VectorXf& freeM
   const float spacing = fabric_.meanSpacing();
   // The fastest particle relative to the cape's rigid motion (predictMotion), m/s.
   const float fastest = predictMotion(state, freeMask, settings.gravity, dt) / dt;
-  constexpr float kSearchMotion = 1.0f;  // spacings of motion one search may cover
+  constexpr float kSearchMotion = 0.75f;  // spacings of motion one search may cover
   if (std::isfinite(fastest) && fastest * settings.timeStep < kSearchMotion * spacing) {
     const float window = std::max(dt, settings.timeStep);
     if (window != dt) predictMotion(state, freeMask, settings.gravity, window);
