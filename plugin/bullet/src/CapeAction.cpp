@@ -16,6 +16,7 @@
 #include <BulletCollision/CollisionShapes/btTriangleCallback.h>
 #include <LinearMath/btAabbUtil2.h>
 #include <LinearMath/btIDebugDraw.h>
+#include <LinearMath/btMotionState.h>
 #include <LinearMath/btTransformUtil.h>
 
 #include <algorithm>
@@ -135,6 +136,71 @@ const CapeMesh& CapeAction::mesh(bool twoSided) const {
     meshAllocated_ = true;
   }
   mesh_.update(cape_.fabric(), positions());
+  return mesh_;
+}
+
+bool CapeAction::renderedPose(const btCollisionWorld& world, const btRigidBody* body,
+                              btTransform& framePose) const {
+  const auto it = trackedIndex_.find(body);
+  if (body == nullptr || it == trackedIndex_.end()) return false;
+  // In the world (pointers only: the slot where the action last saw it, else one scan of the array), so
+  // that a body removed and deleted since the last step is never read.
+  const btCollisionObjectArray& objects = world.getCollisionObjectArray();
+  const int hint = tracked_[it->second].worldIndex;
+  if (hint < 0 || hint >= objects.size() || objects[hint] != body) {
+    if (objects.findLinearSearch(const_cast<btRigidBody*>(body)) >= objects.size()) return false;
+  }
+  btTransform rendered = body->getWorldTransform();
+  if (const btMotionState* m = body->getMotionState()) m->getWorldTransform(rendered);
+  const btMatrix3x3& b = rendered.getBasis();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(double(b[r][c]))) return false;
+    if (!std::isfinite(double(rendered.getOrigin()[r]))) return false;
+  }
+  framePose = toFrame(rendered);
+  return true;
+}
+
+const Points& CapeAction::renderPositions(const btCollisionWorld& world) const {
+  const Points& x = cape_.state().positions;
+  renderPositions_.resize(x.rows(), 3);
+  // The reference body's motion from its pose at the end of the last step to its rendered pose, in the
+  // cape's frame (both poses relative to its origin), applied in double.
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  const btRigidBody* reference = ok() ? referenceBody() : nullptr;
+  btTransform rendered;
+  if (reference != nullptr && renderedPose(world, reference, rendered)) {
+    const btTransform delta = rendered * tracked_[trackedIndex_.at(reference)].stepEnd.inverse();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) rotation(r, c) = double(delta.getBasis()[r][c]);
+      shift[r] = double(delta.getOrigin()[r]);
+    }
+  }
+  const Eigen::Vector3d origin = cape_.origin() + shift;
+  for (Eigen::Index i = 0; i < x.rows(); ++i)
+    renderPositions_.row(i) =
+        (rotation * x.row(i).transpose().cast<double>() + origin).transpose().cast<float>();
+  // Every attached particle exactly on its attachment point at its body's rendered pose.
+  for (const Attachment& a : attachments_) {
+    if (a.particle >= particleCount() || !renderedPose(world, a.body, rendered)) continue;
+    const btVector3 p = rendered * a.localPivot;
+    renderPositions_.row(a.particle) =
+        (Eigen::Vector3d(double(p.x()), double(p.y()), double(p.z())) + cape_.origin())
+            .transpose()
+            .cast<float>();
+  }
+  return renderPositions_;
+}
+
+const CapeMesh& CapeAction::renderMesh(const btCollisionWorld& world, bool twoSided) const {
+  if (!ok()) return mesh_;
+  if (!meshAllocated_ || mesh_.twoSided() != twoSided) {
+    mesh_.allocate(cape_.fabric(), twoSided);
+    meshAllocated_ = true;
+  }
+  mesh_.update(cape_.fabric(), renderPositions(world));
   return mesh_;
 }
 

@@ -222,6 +222,22 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   /// buffers are allocated on the first call (and again only when `twoSided` changes), never after. The
   /// reference stays valid until the next call or the action's end.
   const CapeMesh& mesh(bool twoSided = false) const;
+  /// Particle positions, m, world, at the time of the bodies' rendered poses: what a renderer that draws
+  /// the bodies from their motion states should draw (with a remainder, stepSimulation writes each dynamic
+  /// body's motion state at a time between its last two internal steps, Bullet's interpolation). The cape
+  /// of the last internal step (positions()) is carried rigidly by the reference body's motion from its
+  /// pose at that step to its rendered pose, and every attached particle is put on its attachment point at
+  /// its body's rendered pose: the cape is drawn in the character's frame as it moves on between steps, as
+  /// Chaos Cloth and NvCloth draw the simulation they keep in the character's space. A body's rendered pose
+  /// is its motion state's transform when it has one (Bullet's interpolated pose for a dynamic body, the
+  /// user's for a kinematic one), else its world transform. `world` is the world the action steps in; only
+  /// bodies still in it are read (one that left it, or whose rendered pose is not finite, keeps its pose of
+  /// the last step). Allocates nothing after the first call; valid until the next call; not for concurrent
+  /// callers.
+  const Points& renderPositions(const btCollisionWorld& world) const;
+  /// The render mesh (as mesh()) at renderPositions(world): positions, normals, UVs and triangles as a
+  /// renderer drawing the bodies from their motion states should draw the cape.
+  const CapeMesh& renderMesh(const btCollisionWorld& world, bool twoSided = false) const;
   /// Wall time of the cape's own work in the last internal step (prepare() and advance()), microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
   /// Sum of lastStepMicroseconds() over the internal steps since the last call of this function (a frame's
@@ -306,9 +322,13 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   std::vector<const btCollisionObject*> activeObjects_;
   std::size_t meshCount_ = 0;
 
+  /// The rendered pose of a followed body (renderPositions()) in the cape's frame, if it is in `world`.
+  bool renderedPose(const btCollisionWorld& world, const btRigidBody* body, btTransform& framePose) const;
+
   bool teleported_ = false;
-  mutable Points worldPositions_;  ///< positions() when the frame is away from the world's origin.
-  mutable CapeMesh mesh_;          ///< mesh()'s buffers.
+  mutable Points worldPositions_;   ///< positions() when the frame is away from the world's origin.
+  mutable Points renderPositions_;  ///< renderPositions()'s buffer.
+  mutable CapeMesh mesh_;           ///< mesh()'s buffers.
   mutable bool meshAllocated_ = false;
   std::uint64_t guardReported_ = 0;
   std::uint64_t stepCount_ = 0;
