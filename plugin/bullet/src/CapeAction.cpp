@@ -536,6 +536,7 @@ void CapeAction::applyTeleport() {
   if (!delta.isFinite() || !origin.allFinite()) return;
   cape_.teleport(delta);
   moveFrame(origin, true);
+  if (settings_.teleportMode == TeleportMode::Reset) cape_.resetToReference();
   teleported_ = true;
 }
 

@@ -214,6 +214,22 @@ void Cape::teleport(const Pose& delta) {
   }
 }
 
+void Cape::resetToReference() {
+  if (!ok()) return;
+  wake();
+  fitReferenceToPins();
+  const Points& rest = fabric_->restPositions();
+  for (Eigen::Index i = 0; i < state_.positions.rows(); ++i)
+    state_.positions.row(i) = reference_.apply(rest.row(i).transpose()).transpose();
+  for (Pin& p : state_.pins) {
+    p.previousTarget = p.target;
+    state_.positions.row(p.particle) = p.target.transpose();
+  }
+  state_.velocities.setZero();
+  work_->startPositions = state_.positions;
+  work_->self.forget();
+}
+
 void Cape::carry(const Eigen::Matrix3f& m, const Vec3& centre, const Vec3& shift) {
   if (!ok() || !m.allFinite() || !centre.allFinite() || !shift.allFinite()) return;
   if (m == Eigen::Matrix3f::Identity() && shift.isZero()) return;  // carries nothing

@@ -5,6 +5,7 @@
 
 #include "cape/core/Cape.h"
 
+#include <limits>
 #include <vector>
 
 namespace cape::detail {
@@ -28,6 +29,12 @@ class SelfCollision {
   /// Keeps every contact's particle on its side of its triangle, at least the thickness away (a PBD pass
   /// with inverse masses `w`).
   void solve(Points& positions, const float* w, float thickness);
+
+  /// Drops the contacts: the next step searches afresh (the cape was put somewhere else).
+  void forget() {
+    contacts_.clear();
+    validUntil_ = -std::numeric_limits<double>::infinity();
+  }
 
   const std::vector<Cape::SelfContact>& contacts() const { return contacts_; }
   std::uint64_t searches() const { return searches_; }

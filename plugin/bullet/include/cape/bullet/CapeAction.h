@@ -50,6 +50,14 @@ namespace cape::bullet {
 /// Receives the adapter's warnings (unsupported shapes, bodies removed while attached). Default: stderr.
 using WarningHandler = std::function<void(const std::string&)>;
 
+/// What a teleport does to the cape (CapeActionSettings::teleportMode), as Magica Cloth 2's and Chaos
+/// Cloth's teleport controls.
+enum class TeleportMode {
+  Keep,   ///< The cape is moved rigidly with the body: its shape, folds and swing (turned) kept.
+  Reset,  ///< The cape is moved with the body and put back at rest in its reference pose
+          ///< (Cape::resetToReference).
+};
+
 /// Per-action parameters, plain data with units.
 struct CapeActionSettings {
   /// Find colliders automatically (through the world's broadphase): every collision object whose broadphase
@@ -82,6 +90,9 @@ struct CapeActionSettings {
   /// teleports: the whole cape is moved rigidly with it (Cape::teleport) and no collider is swept.
   btScalar teleportDistance = btScalar(1);
   btScalar teleportAngle = btScalar(1.0);  ///< rad: a turn in one step beyond this teleports (see above).
+  /// After the rigid move of a teleport, keep the cape's shape and motion or reset it to rest in its
+  /// reference pose (TeleportMode).
+  TeleportMode teleportMode = TeleportMode::Keep;
 
   /// Take gravity from the world the cape steps in (btDynamicsWorld::getGravity(), read before every step),
   /// so a Z-up world or a changed gravity needs nothing more. Off: CapeSettings::gravity stays in force. A

@@ -89,6 +89,12 @@ class CAPE_CORE_API Cape {
   /// Moves every particle and target rigidly by `delta` (pose applied to world positions) and rotates
   /// velocities with it: what a teleport of the character does to its cape, without stretching it.
   void teleport(const Pose& delta);
+  /// Puts the cape back in its reference pose: the rest shape fitted to the pins' targets (referencePose(),
+  /// refitted here), every free particle at rest there, every pinned particle at rest on its pin's target
+  /// (the pin's sweep starting there), the self-contacts searched afresh at the next step. What a teleport
+  /// does with CapeActionSettings::teleportMode Reset after carrying the cape; also for a game's own resets
+  /// (a respawn, a cut).
+  void resetToReference();
   /// Carries every particle, and the start of every pin's sweep, by x -> rotation (x - centre) + centre +
   /// shift, velocities turned by the rotation; the pins' targets at the end of the next step stay. What a
   /// character-cloth "inertia" below 1 does before a step: the part of the body's motion the cape should not
