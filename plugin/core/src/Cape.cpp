@@ -1,5 +1,7 @@
 #include "cape/core/Cape.h"
 
+#include "cape/core/CapeMesh.h"
+
 #include "cape/core/Wind.h"
 
 #include "CapeScratch.h"
@@ -89,6 +91,114 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   pinnedComponent_.assign(fabric_->componentCount(), 0);
   work_ = std::make_unique<detail::CapeScratch>(*fabric_);
   work_->startPositions = state_.positions;
+  animated_ = state_.positions;
+  animatedNormals_ = Points::Zero(n, 3);
+}
+
+Status Cape::setMotionConstraints(const MotionConstraints& c) {
+  if (!ok()) return status_;
+  const Eigen::Index n = state_.positions.rows();
+  const auto check = [n](const Eigen::VectorXf& v, const char* name, float lo, float hi,
+                         bool infinityAllowed) -> Status {
+    if (v.size() == 0) return Status::success();
+    if (v.size() != n)
+      return Status::error(std::string("MotionConstraints: ") + name + " has " + std::to_string(v.size()) +
+                           " values for " + std::to_string(n) + " particles");
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const float x = v[i];
+      const bool inRange = x >= lo && x <= hi && (infinityAllowed || std::isfinite(x));
+      if (!inRange)
+        return Status::error(std::string("MotionConstraints: ") + name + " of particle " + std::to_string(i) +
+                             " is " + std::to_string(x) + ", outside its range");
+    }
+    return Status::success();
+  };
+  const float inf = std::numeric_limits<float>::infinity();
+  for (const Status& st : {check(c.maxDistance, "maxDistance", 0.0f, inf, true),
+                           check(c.backstopRadius, "backstopRadius", 0.0f, inf, false),
+                           check(c.backstopDistance, "backstopDistance", 0.0f, inf, false),
+                           check(c.drive, "drive", 0.0f, 1.0f, false)})
+    if (!st.ok()) return st;
+  if (c.backstopDistance.size() != 0 && c.backstopRadius.size() == 0)
+    return Status::error("MotionConstraints: backstopDistance without backstopRadius");
+  motion_ = c;
+  motionActive_ = c.maxDistance.size() != 0 || c.backstopRadius.size() != 0 || c.drive.size() != 0;
+  wake();
+  return Status::success();
+}
+
+Status Cape::setAnimatedPositions(const Points& positions) {
+  if (!ok()) return status_;
+  if (positions.rows() == 0) {
+    userAnimated_ = false;
+    wake();
+    return Status::success();
+  }
+  if (positions.rows() != state_.positions.rows())
+    return Status::error("Cape::setAnimatedPositions: " + std::to_string(positions.rows()) +
+                         " positions for " + std::to_string(state_.positions.rows()) + " particles");
+  if (!positions.allFinite()) return Status::error("Cape::setAnimatedPositions: a position is not finite");
+  if (userAnimated_ && positions == animated_) return Status::success();
+  animated_ = positions;
+  userAnimated_ = true;
+  wake();
+  return Status::success();
+}
+
+void Cape::animate() {
+  // The rest shape fitted to the pins' targets at the end of this step (unless the caller animates), and
+  // the animated surface's normals for the backstops.
+  if (!userAnimated_) {
+    fitReferenceToPins();
+    const Points& rest = fabric_->restPositions();
+    const Eigen::Matrix3f r = reference_.rotation.toRotationMatrix();
+    for (Eigen::Index i = 0; i < rest.rows(); ++i)
+      animated_.row(i) = (r * rest.row(i).transpose() + reference_.position).transpose();
+  }
+  if (motion_.backstopRadius.size() != 0)
+    computeVertexNormals(animated_, fabric_->triangles(), animatedNormals_);
+}
+
+void Cape::applyMotionConstraints(float h, bool explicitMode) {
+  // Drive, then backstops, then the max distance (last, so that it holds at the end of the step). Plain
+  // loops over particles; only free particles move.
+  const Eigen::Index n = state_.positions.rows();
+  const float* w = state_.inverseMasses.data();
+  const bool drive = motion_.drive.size() != 0, backstop = motion_.backstopRadius.size() != 0,
+             limit = motion_.maxDistance.size() != 0;
+  const float side = motion_.backstopAlongNormal ? 1.0f : -1.0f;
+  const float frames = h * 60.0f;  // the drive is given per 1/60 s
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!(w[i] > 0.0f)) continue;
+    const Vec3 a = animated_.row(i).transpose();
+    Vec3 x = state_.positions.row(i).transpose();
+    const Vec3 before = x;
+    if (drive) {
+      const float d = motion_.drive[i];
+      const float k = d >= 1.0f ? 1.0f : 1.0f - std::pow(1.0f - d, frames);
+      x += k * (a - x);
+    }
+    if (backstop && motion_.backstopRadius[i] > 0.0f) {
+      const float r = motion_.backstopRadius[i];
+      const float gap = motion_.backstopDistance.size() != 0 ? motion_.backstopDistance[i] : 0.0f;
+      const Vec3 normal = animatedNormals_.row(i).transpose();
+      const Vec3 c = a + (side * (gap + r)) * normal;
+      const Vec3 u = x - c;
+      const float len = u.norm();
+      if (len < r) x = c + (len > 1e-9f * r ? (r / len) * u : (-side * r) * normal);
+    }
+    if (limit) {
+      const float reach = motion_.maxDistance[i];
+      const Vec3 u = x - a;
+      const float len = u.norm();
+      if (len > reach) x = a + (reach / len) * u;
+    }
+    if (x != before) {
+      state_.positions.row(i) = x.transpose();
+      // The explicit integrator keeps its velocities: give them the move (XPBD derives them afterwards).
+      if (explicitMode) state_.velocities.row(i) += ((x - before) / h).transpose();
+    }
+  }
 }
 
 Cape::~Cape() = default;
@@ -347,6 +457,7 @@ void Cape::beginStep(float dt, ColliderSpan colliders) {
   // Triangle meshes: each particle's candidate triangles for the whole step, found once. The slack, a
   // quarter of the spacing, is the self-collision search's for the same reason.
   work_->body.beginStep(state_, colliders, settings_, dt, 0.25f * fabric_->meanSpacing());
+  if (motionActive_) animate();
 }
 
 void Cape::endStep(float dt) {
@@ -543,6 +654,7 @@ void Cape::substepXpbd(float h, float s0, float s1, ColliderSpan colliders) {
   solveConstraints(h);
   collideBodies(h, s0, s1, colliders, false);
   if (settings_.selfCollision) solveSelfContactsAfterBodies();
+  if (motionActive_) applyMotionConstraints(h, false);
   updateVelocities(h);
 }
 
@@ -661,6 +773,7 @@ void Cape::substepExplicit(float h, float s0, float s1, ColliderSpan colliders) 
   state_.positions += h * state_.velocities;
   movePinsTo(s1, h);
   collideBodies(h, s0, s1, colliders, true);
+  if (motionActive_) applyMotionConstraints(h, true);
 }
 
 void Cape::accumulateSpringForces() {

@@ -21,6 +21,31 @@ namespace detail {
 struct CapeScratch;
 }
 
+/// Per-particle constraints of a cape to its animated pose (NvCloth's motion and separation constraints,
+/// Chaos Cloth's max distance, backstop and anim drive): each particle's animated position is where the
+/// animation puts it, by default the fabric's rest shape fitted to the pins at the end of each step (so it
+/// rides with the body the cape is pinned to), or positions the caller gives every step (a skinning:
+/// Cape::setAnimatedPositions). An empty array switches its constraint off; otherwise it has one value per
+/// particle (a weight map). Pinned particles are not moved by them. Applied in every substep after the
+/// collisions, the max distance last: at the end of every step no particle is farther than its max
+/// distance from its animated position.
+struct MotionConstraints {
+  /// m: the farthest each particle may be from its animated position; +inf: no limit for it.
+  Eigen::VectorXf maxDistance;
+  /// m: the radius of each particle's backstop, a sphere behind its animated position that it may not enter
+  /// (0: none for it). Behind is against the animated surface's normal (the counter-clockwise side, as
+  /// CapeMesh's normals), or along it when backstopAlongNormal.
+  Eigen::VectorXf backstopRadius;
+  /// m: how far behind the animated position the backstop's surface lies (its centre is backstopDistance
+  /// plus backstopRadius behind it); empty: 0 for every particle.
+  Eigen::VectorXf backstopDistance;
+  /// Put the backstops on the side the normals point to instead of the other.
+  bool backstopAlongNormal = false;
+  /// 0..1: the anim drive, the part of the way to its animated position each particle is moved per 1/60 s
+  /// (whatever the substeps); 1 holds it there exactly.
+  Eigen::VectorXf drive;
+};
+
 /// A view of the colliders for one step (the caller owns them; see Collider::moveTo).
 struct ColliderSpan {
   const Collider* data = nullptr;  ///< The first collider.
@@ -89,6 +114,22 @@ class CAPE_CORE_API Cape {
   /// Moves every particle and target rigidly by `delta` (pose applied to world positions) and rotates
   /// velocities with it: what a teleport of the character does to its cape, without stretching it.
   void teleport(const Pose& delta);
+  /// Sets the motion constraints (MotionConstraints): an error, keeping the old ones, when an array that is
+  /// not empty has another size than the particles, or a value out of range (max distance not >= 0, a
+  /// backstop radius or distance negative or not finite, a drive outside 0..1).
+  Status setMotionConstraints(const MotionConstraints& constraints);
+  /// The motion constraints in use.
+  const MotionConstraints& motionConstraints() const { return motion_; }
+  /// The animated position of every particle for the next step and those after (frame coordinates, m, one
+  /// row per particle): a skinning the caller gives, again whenever it moves. An empty matrix goes back to
+  /// the default, the rest shape fitted to the pins at the end of each step. An error on a wrong size or a
+  /// position that is not finite.
+  Status setAnimatedPositions(const Points& positions);
+  /// The animated positions of the last step (frame coordinates, m) and their vertex normals.
+  const Points& animatedPositions() const { return animated_; }
+  /// The animated surface's area-weighted vertex normals of the last step (unit, counter-clockwise side).
+  const Points& animatedNormals() const { return animatedNormals_; }
+
   /// Puts the cape back in its reference pose: the rest shape fitted to the pins' targets (referencePose(),
   /// refitted here), every free particle at rest there, every pinned particle at rest on its pin's target
   /// (the pin's sweep starting there), the self-contacts searched afresh at the next step. What a teleport
@@ -207,6 +248,9 @@ class CAPE_CORE_API Cape {
   void collideBodies(float h, float s0, float s1, ColliderSpan colliders, bool explicitMode);
   void solveSelfContactsAfterBodies();
   void updateVelocities(float h);
+  /// The motion constraints' animated pose of this step (beginStep), and their pass over the particles.
+  void animate();
+  void applyMotionConstraints(float h, bool explicitMode);
   // Their parts.
   void accumulateExternalAcceleration();
   void accumulateSpringForces();
@@ -226,6 +270,11 @@ class CAPE_CORE_API Cape {
   Pose reference_;                                    ///< The rest shape's pose in the frame.
   std::vector<std::uint8_t> pinnedComponent_;         ///< 1 for each fabric component holding a pin.
   GuardReport guard_;
+  MotionConstraints motion_;
+  bool motionActive_ = false;  ///< Some array of motion_ is set.
+  bool userAnimated_ = false;  ///< animated_ is the caller's (setAnimatedPositions), not the fit.
+  Points animated_;            ///< Animated positions (frame), m.
+  Points animatedNormals_;     ///< Their vertex normals.
   bool asleep_ = false;
   float stillTime_ = 0.0f;  ///< s the cape has been slow with its surroundings still
   std::uint64_t sleptSteps_ = 0;
