@@ -12,6 +12,7 @@
 #include "cape/scenes/Metrics.h"
 #include "cape/scenes/Scene.h"
 
+#include "CapedHumanoid.h"
 #include "CharacterTestWorld.h"
 
 #include <gtest/gtest.h>
@@ -73,60 +74,17 @@ struct Recovery {
   }
 };
 
-/// The shipped humanoid standing still (its standing pose held through setMotion), an N x N cape pinned by
-/// its top corners to the shoulders and hanging behind the back, placed as BulletScene places it (the pin
-/// line 4 cm above the shoulders' centre and 3 cm behind the back, the width and length fitted), stepped
-/// stepSimulation(1/60, 8, 1/240) with the default CapeActionSettings (a jump beyond 1 m or 1 rad teleports
-/// the cape with the character; the 0.5 m one is swept, at 30 m/s).
+/// The shipped humanoid standing still (its standing pose held through setMotion) wearing an N x N cape
+/// (CapedHumanoid), stepped stepSimulation(1/60, 8, 1/240) with the default CapeActionSettings (a jump beyond
+/// 1 m or 1 rad teleports the cape with the character; the 0.5 m one is swept, at 30 m/s).
 Recovery runJump(int n, bool selfCollision, Jump jump) {
-  capetest::World w;
   Recovery out;
-  CharacterResult made =
-      Character::create(UrdfModel::humanoid().model, w.world, Gait::forScene(cape::SceneKind::Hang));
-  EXPECT_TRUE(made.ok()) << made.status.message();
-  if (!made.ok()) return out;
-  Character& c = *made.character;
-  const ShoulderAnchors a = findShoulderAnchors(c);
-  EXPECT_TRUE(a.status.ok()) << a.status.message();
-  if (!a.status.ok()) return out;
-
-  // The cape's size and pin line as the demos fit them (demos/src/BulletScene.cpp).
-  cape::CapeSize size;
-  const double span = std::fabs(a.right.x() - a.left.x());
-  size.width = static_cast<float>(std::round(std::clamp(span + 0.16, 0.2, 3.0) * 1000.0) / 1000.0);
-  const double pinHeight = 0.5 * (a.left.y() + a.right.y()) + 0.04;
-  size.height = static_cast<float>(std::round(std::clamp(pinHeight - 0.45, 0.2, 1.0) * 1000.0) / 1000.0);
-  const cape::CapeRig rig = cape::makeCapeRig(n, cape::PinLayout::Corners, true, size);
-  EXPECT_TRUE(rig.fabric != nullptr);
-  if (!rig.fabric) return out;
-  const cape::Vec3 centre = (a.left.cast<float>() + a.right.cast<float>()) / 2.0f;
-  const cape::Vec3 shift =
-      centre + cape::Vec3(0.0f, 0.04f, static_cast<float>(a.back + 0.03)) - cape::Vec3(0.0f, 1.56f, 0.15f);
-  cape::Pose placement = cape::capeStartPlacement(cape::SceneKind::Walk, size);  // hanging straight down
-  placement.position += shift;
-
-  cape::CapeSettings settings;
-  settings.selfCollision = selfCollision;
-  CapeAction action(rig.fabric, cape::settingsForScene(cape::SceneKind::Hang, settings), toBt(placement));
-  EXPECT_TRUE(action.ok()) << action.cape().status().message();
-  if (!action.ok()) return out;
+  capetest::CapedHumanoid h(n, selfCollision, cape::SceneKind::Hang);
+  if (!h.ok) return out;
+  capetest::World& w = h.w;
+  Character& c = *h.character;
+  CapeAction& action = *h.action;
   action.setWarningHandler([](const std::string&) {});  // what the guard did is measured here
-  std::vector<std::pair<float, btRigidBody*>> anchors;
-  for (int link : {a.leftLink, a.rightLink}) {
-    btRigidBody* body = c.bodies().bodyForLink(link);
-    EXPECT_NE(body, nullptr);
-    if (!body) return out;
-    anchors.emplace_back(static_cast<float>(c.skeleton().linkPose(link).translation().x()), body);
-  }
-  for (std::size_t p = 0; p < rig.pinnedParticles.size(); ++p) {
-    const cape::Vec3 point = rig.pinLocalPoints[p] + shift;
-    const auto nearest = std::min_element(anchors.begin(), anchors.end(), [&](const auto& l, const auto& r) {
-      return std::fabs(l.first - point.x()) < std::fabs(r.first - point.x());
-    });
-    btRigidBody* body = nearest->second;
-    action.attach(rig.pinnedParticles[p], body, body->getWorldTransform().inverse() * toBt(point));
-  }
-  w.world.addAction(&action);
 
   // The root link held where it stands, then moved once and held there.
   const Eigen::Isometry3d standing = c.skeleton().linkPose(0);
@@ -164,7 +122,6 @@ Recovery runJump(int n, bool selfCollision, Jump jump) {
     out.strain.push_back(strain);
     out.guarded.push_back(restored);
   }
-  w.world.removeAction(&action);
   return out;
 }
 
