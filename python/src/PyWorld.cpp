@@ -559,6 +559,24 @@ void World::setCapeSettings(int cape, const cape::CapeSettings& settings) {
   if (!s.ok()) fail("cape settings: " + s.message());
 }
 
+void World::setMotionConstraints(int cape, const cape::MotionConstraints& constraints) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  checkCape(cape);
+  const cape::Status s =
+      capes_[static_cast<std::size_t>(cape)]->action->cape().setMotionConstraints(constraints);
+  if (!s.ok()) fail(s.message());
+}
+
+cape::Points World::capeAnimatedPositions(int cape) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  checkCape(cape);
+  const cape::Cape& c = capes_[static_cast<std::size_t>(cape)]->action->cape();
+  cape::Points x = c.animatedPositions();
+  const Eigen::Vector3d& o = c.origin();
+  for (int k = 0; k < 3; ++k) x.col(k) = (x.col(k).cast<double>().array() + o[k]).cast<float>().matrix();
+  return x;
+}
+
 void World::setCountSelfIntersections(int cape, bool on) {
   std::lock_guard<std::mutex> lock(mutex_);
   checkCape(cape);

@@ -135,6 +135,10 @@ class World {
   std::string capeDescription(int cape) const;
   cape::CapeSettings capeSettings(int cape) const;
   void setCapeSettings(int cape, const cape::CapeSettings& settings);
+  /// Cape::setMotionConstraints; a ValueError with the library's message on bad arrays.
+  void setMotionConstraints(int cape, const cape::MotionConstraints& constraints);
+  /// Each particle's animated position of the last step (Cape::animatedPositions), m, world.
+  cape::Points capeAnimatedPositions(int cape) const;
   /// Also counts self-intersecting triangle pairs in the per-frame metrics (costs a spatial hash a frame).
   void setCountSelfIntersections(int cape, bool on);
   bool countSelfIntersections(int cape) const;

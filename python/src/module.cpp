@@ -314,6 +314,45 @@ void bindHandles(py::module_& m) {
           "positions", [](const CapeHandle& c) { return pointsToArray(c.world->capePositions(c.index)); },
           "(N, 3) float32, m, world.")
       .def_property_readonly(
+          "animated_positions",
+          [](const CapeHandle& c) { return pointsToArray(c.world->capeAnimatedPositions(c.index)); },
+          "(N, 3) float32, m, world: each particle's animated position of the last step (the rest shape "
+          "fitted to the pins), what set_motion_constraints holds the cape to.")
+      .def(
+          "set_motion_constraints",
+          [](const CapeHandle& c, const py::object& maxDistance, const py::object& backstopRadius,
+             const py::object& backstopDistance, const py::object& drive, bool backstopAlongNormal) {
+            const Eigen::Index n = c.world->capePositions(c.index).rows();
+            // None: off; a number: the same for every particle; else one value per particle (a weight map).
+            const auto values = [n](const py::object& o, const char* name) {
+              Eigen::VectorXf v;
+              if (o.is_none()) return v;
+              if (py::isinstance<py::float_>(o) || py::isinstance<py::int_>(o)) {
+                v = Eigen::VectorXf::Constant(n, o.cast<float>());
+                return v;
+              }
+              const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(o);
+              if (!a || a.ndim() != 1)
+                throw py::value_error(std::string(name) + " must be None, a number or a 1-D array of " +
+                                      std::to_string(n) + " values");
+              v = Eigen::Map<const Eigen::VectorXf>(a.data(), a.shape(0));
+              return v;
+            };
+            cape::MotionConstraints m;
+            m.maxDistance = values(maxDistance, "max_distance");
+            m.backstopRadius = values(backstopRadius, "backstop_radius");
+            m.backstopDistance = values(backstopDistance, "backstop_distance");
+            m.drive = values(drive, "drive");
+            m.backstopAlongNormal = backstopAlongNormal;
+            c.world->setMotionConstraints(c.index, m);
+          },
+          py::kw_only(), "max_distance"_a = py::none(), "backstop_radius"_a = py::none(),
+          "backstop_distance"_a = py::none(), "drive"_a = py::none(), "backstop_along_normal"_a = false,
+          "Motion constraints to each particle's animated position (animated_positions): max_distance (m), "
+          "backstop_radius and backstop_distance (m: a sphere behind the animated surface), drive (0..1 per "
+          "1/60 s). Each None (off), a number (every particle) or one value per particle (a weight map, e.g. "
+          "from the uvs). ValueError on bad values; the old constraints are kept then.")
+      .def_property_readonly(
           "normals", [](const CapeHandle& c) { return pointsToArray(c.world->capeNormals(c.index)); },
           "(N, 3) float32 unit area-weighted vertex normals.")
       .def_property_readonly(

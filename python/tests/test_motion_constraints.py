@@ -1,0 +1,54 @@
+"""Motion constraints from Python: a max distance painted from the UVs holds the cape to its animated pose."""
+import numpy as np
+import pytest
+
+import capecloth
+
+
+def shaken(cape, world, left, right, frames):
+    """Shakes the two shoulder spheres sideways (0.3 m at 2 Hz), one frame at a time, yielding each frame."""
+    for k in range(1, frames + 1):
+        dx = 0.3 * np.sin(2 * np.pi * 2 * k / 60)
+        left.set_pose(position=[-0.22 + dx, 1.52, 0])
+        right.set_pose(position=[0.22 + dx, 1.52, 0])
+        world.step()
+        yield k
+
+
+def test_a_max_distance_weight_map_from_the_uvs_holds_the_cape():
+    world = capecloth.World()
+    left = world.add_sphere(0.08, pose=[-0.22, 1.52, 0, 0, 0, 0, 1])
+    right = world.add_sphere(0.08, pose=[0.22, 1.52, 0, 0, 0, 0, 1])
+    cape = world.add_cape([left, right])
+    reach = 0.02 + 0.1 * cape.uvs[:, 1]  # 2 cm at the collar (v = 0), 12 cm at the hem
+    cape.set_motion_constraints(max_distance=reach)
+    worst, farthest = -1.0, 0.0
+    for _ in shaken(cape, world, left, right, 90):
+        d = np.linalg.norm(cape.positions - cape.animated_positions, axis=1)
+        worst = max(worst, float((d - reach).max()))
+        farthest = max(farthest, float(d.max()))
+    assert worst < 1e-4
+    assert farthest > 0.05  # the hem uses its reach
+
+
+def test_a_drive_of_one_holds_the_animated_pose_and_bad_values_raise():
+    world = capecloth.World()
+    left = world.add_sphere(0.08, pose=[-0.22, 1.52, 0, 0, 0, 0, 1])
+    right = world.add_sphere(0.08, pose=[0.22, 1.52, 0, 0, 0, 0, 1])
+    cape = world.add_cape([left, right])
+    cape.set_motion_constraints(drive=1.0)
+    for _ in shaken(cape, world, left, right, 30):
+        assert np.abs(cape.positions - cape.animated_positions).max() < 1e-4
+    n = cape.particle_count
+    with pytest.raises(ValueError, match="MotionConstraints"):
+        cape.set_motion_constraints(max_distance=np.ones(n - 1))
+    with pytest.raises(ValueError, match="MotionConstraints"):
+        cape.set_motion_constraints(drive=1.5)
+    with pytest.raises(ValueError, match="MotionConstraints"):
+        cape.set_motion_constraints(max_distance=np.full(n, np.nan))
+    with pytest.raises(ValueError, match="1-D"):
+        cape.set_motion_constraints(max_distance=np.ones((n, 2)))
+    cape.set_motion_constraints()  # all off
+    for _ in shaken(cape, world, left, right, 30):
+        pass
+    assert np.abs(cape.positions - cape.animated_positions).max() > 0.01
