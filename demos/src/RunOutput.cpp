@@ -39,6 +39,7 @@ json settingsJson(const CapeSettings& s) {
           {"structural_stiffness_n_per_m", s.structuralStiffness},
           {"shear_stiffness_n_per_m", s.shearStiffness},
           {"bend_stiffness_n_per_m", s.bendStiffness},
+          {"bending_rigidity_n_m", s.bendingRigidity},
           {"tethers", s.useTethers},
           {"damping_per_s", s.damping},
           {"collision_thickness_m", s.collisionThickness},

@@ -149,6 +149,8 @@ void bindSettings(py::module_& m) {
       .def_readwrite("structural_stiffness", &cape::CapeSettings::structuralStiffness, "N/m per spring.")
       .def_readwrite("shear_stiffness", &cape::CapeSettings::shearStiffness, "N/m per spring.")
       .def_readwrite("bend_stiffness", &cape::CapeSettings::bendStiffness, "N/m per spring.")
+      .def_readwrite("bending_rigidity", &cape::CapeSettings::bendingRigidity,
+                     "N m: linear bending, flexural rigidity per unit width (0 = off).")
       .def_readwrite("use_tethers", &cape::CapeSettings::useTethers)
       .def_readwrite("damping", &cape::CapeSettings::damping, "1/s: dv/dt = -damping v.")
       .def_readwrite("collision_thickness", &cape::CapeSettings::collisionThickness, "m.")

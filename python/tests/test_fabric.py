@@ -17,8 +17,9 @@ def test_fabric_presets_set_the_springs_for_the_grid():
     stiff = world.add_cape([a, b], fabric="leather")
     plain = world.add_cape([a, b])
     assert "silk" in silky.description
-    assert stiff.settings.bend_stiffness > silky.settings.bend_stiffness
-    assert silky.settings.bend_stiffness != plain.settings.bend_stiffness
+    assert stiff.settings.bending_rigidity > silky.settings.bending_rigidity
+    assert silky.settings.bending_rigidity == pytest.approx(silk["bending_rigidity"])
+    assert plain.settings.bending_rigidity == 0.0 and silky.settings.bend_stiffness == 0.0
     with pytest.raises(ValueError, match="silk"):
         world.add_cape([a, b], fabric="tinfoil")
     with pytest.raises(ValueError, match="tinfoil"):

@@ -1,5 +1,6 @@
 // Fabric presets: the published figures and their units, the mapping onto per-spring stiffness, bad input.
 #include "cape/core/FabricPresets.h"
+#include "cape/scenes/Textile.h"
 
 #include "CapeTestFixture.h"
 
@@ -74,33 +75,15 @@ TEST(FabricPresets, MembraneStiffnessIsIndependentOfTheSpacing) {
   }
 }
 
-TEST(FabricPresets, TheHingeStiffnessScalesAsTheInverseFourthPowerOfTheSpacing) {
-  const FabricMaterial& wool = *findFabric("wool");
-  const float k1 = fabricHingeStiffness(wool, 0.01f);
-  const float k2 = fabricHingeStiffness(wool, 0.02f);
-  EXPECT_NEAR(k1 / k2, 16.0f, 1e-3f);
-  // Equal moments at the curvature 1/c: the hinge angle there is h / c, the hinge's moment k h^2 theta^3 / 8
-  // and the strip's B theta.
-  const float h = 0.01f, c = wool.bendingLength(), theta = h / c;
-  EXPECT_NEAR(k1 * h * h * theta * theta * theta / 8.0f, wool.bendingRigidity * theta,
-              1e-5f * wool.bendingRigidity * theta);
-}
-
-TEST(FabricPresets, TheBendSpringAndTheTwoSegmentsItSpansMakeTheHinge) {
+TEST(FabricPresets, BendingIsTheMaterialsRigidityAndTheBendSpringsAreOff) {
   for (const FabricMaterial& m : fabricPresets()) {
-    for (float h : {0.004f, 0.01f, 0.03f}) {
-      const double hinge = fabricHingeStiffness(m, h), bend = fabricBendStiffness(m, h);
-      ASSERT_TRUE(std::isfinite(bend)) << m.name << " " << h;
-      EXPECT_GT(bend, hinge);
-      EXPECT_NEAR(1.0 / (1.0 / bend + 2.0 / m.stretchStiffness), hinge, 1e-4 * hinge) << m.name << " " << h;
+    for (float h : {0.0005f, 0.01f, 0.1f}) {
+      const CapeSettings s = applyFabric(m, h);
+      EXPECT_EQ(s.bendingRigidity, m.bendingRigidity) << m.name;
+      EXPECT_EQ(s.bendStiffness, 0.0f) << m.name;
+      EXPECT_TRUE(s.validate().ok()) << s.validate().message();
     }
   }
-  // A hinge stiffer than half the segments' own stiffness cannot be built from a spring: the bend spring is
-  // then inextensible. Silk on a 0.5 mm grid asks for about 3.9e4 N/m against Y / 2 = 3.1e3 N/m.
-  const FabricMaterial& silk = *findFabric("silk");
-  EXPECT_GT(fabricHingeStiffness(silk, 0.0005f), silk.stretchStiffness / 2.0f);
-  EXPECT_TRUE(std::isinf(fabricBendStiffness(silk, 0.0005f)));
-  EXPECT_TRUE(applyFabric(silk, 0.0005f).validate().ok());
 }
 
 TEST(FabricPresets, ApplyFabricKeepsEverythingElseFromTheBase) {
@@ -120,7 +103,7 @@ TEST(FabricPresets, ApplyFabricKeepsEverythingElseFromTheBase) {
   EXPECT_EQ(s.damping, cotton.damping);
   EXPECT_EQ(s.wind.dragCoefficient, cotton.dragCoefficient);
   EXPECT_EQ(s.wind.liftCoefficient, cotton.liftCoefficient);
-  EXPECT_EQ(s.bendStiffness, fabricBendStiffness(cotton, 0.03f));
+  EXPECT_EQ(s.bendingRigidity, cotton.bendingRigidity);
 }
 
 TEST(FabricPresets, FabricMassIsDensityTimesArea) {
@@ -135,7 +118,7 @@ TEST(FabricPresets, BadInputIsRefusedWithAMessageAndLeavesTheBase) {
   const FabricMaterial& silk = *findFabric("silk");
   CapeSettings base;
   base.bendStiffness = 123.0f;
-  for (float h : {0.0f, -0.01f, kNaN, kInf, 1e-12f}) {
+  for (float h : {0.0f, -0.01f, kNaN, kInf}) {
     const Status st = checkFabric(silk, h);
     EXPECT_FALSE(st.ok()) << h;
     EXPECT_NE(st.message().find("spacing"), std::string::npos) << st.message();
@@ -177,106 +160,23 @@ TEST(FabricPresets, BadInputIsRefusedWithAMessageAndLeavesTheBase) {
   expectRefused(m, "liftCoefficient");
 }
 
-// The cantilever bending test of Peirce (1930, "The 'handle' of cloth as a measurable quantity", J. Text.
-// Inst. 21:T377) as ASTM D1388 and BS 3356 run it: a strip lies flat on a platform with a length L
-// overhanging its edge; under its own weight the overhang droops, and the chord from the edge to the tip
-// falls theta below the horizontal. The bending length is c = L (cos(theta / 2) / (8 tan theta))^(1/3) (c = L
-// / 2 at the standard 41.5 degrees), and for an ideal elastic strip c = (B / w)^(1/3).
-//
-// Here the platform is two clamped rows of particles (the tangent at the edge held flat); the strip is
-// `columns` particles wide, of spacing h = L / segments along and across. The grid spreads its mass evenly
-// over the particles, so each particle stands for an h x h tile: the strip's mass is rho_A * (columns h) *
-// (rows h), and its bend springs (one per column per hinge) carry the width columns * h as well.
-struct CantileverSetup {
-  int segments = 16;      ///< hinges along the overhang
-  int columns = 3;        ///< particles across the strip
-  int substeps = 100;     ///< per 1/60 s
-  int iterations = 1;     ///< per substep
-  float seconds = 6.0f;   ///< settling time, s
-  float damping = 30.0f;  ///< 1/s: settles the strip sooner; its rest shape does not depend on it
-};
-
-struct CantileverResult {
-  float theta = 0.0f;          ///< rad, the tip's droop below the clamp's edge
-  float bendingLength = 0.0f;  ///< m, Peirce's c from theta
-  float maxSpeed = 0.0f;       ///< m/s at the end: whether it settled
-};
-
-CantileverResult cantilever(const FabricMaterial& m, float overhang, const CantileverSetup& setup) {
-  const float h = overhang / static_cast<float>(setup.segments);
-  const int rows = setup.segments + 2;  // rows 0 and 1 are clamped: row 1 is the platform's edge
-  GridDesc g;
-  g.columns = setup.columns;
-  g.rows = rows;
-  g.width = h * static_cast<float>(setup.columns - 1);
-  g.height = h * static_cast<float>(rows - 1);
-  g.totalMass = fabricMass(m, h * static_cast<float>(setup.columns), h * static_cast<float>(rows));
-  g.bendSprings = true;
-  FabricResult fabric = Fabric::grid(g);
-  EXPECT_TRUE(fabric.status.ok()) << fabric.status.message();
-  if (!fabric) return {};
-
-  CapeSettings base = test::quietSettings();
-  base.gravity = Vec3(0.0f, -kStandardGravity, 0.0f);
-  base.substeps = setup.substeps;
-  base.iterations = setup.iterations;
-  base.sleepSpeed = 0.0f;
-  CapeSettings settings = applyFabric(m, h, base);
-  settings.damping = setup.damping;
-  // The grid lies in its x-y plane with row r at y = -r h: turn it so the rows run along +X (the overhang)
-  // and the columns along +Z, the fabric horizontal with gravity along -Y.
-  Eigen::Matrix3f r;
-  r.col(0) = Vec3::UnitZ();   // grid x (across the strip) -> world z
-  r.col(1) = -Vec3::UnitX();  // grid y (up the strip, towards row 0) -> world -x
-  r.col(2) = -Vec3::UnitY();
-  Pose placement;
-  placement.rotation = Quat(r);
-  Cape cape(fabric.fabric, settings, placement);
-  EXPECT_TRUE(cape.ok()) << cape.status().message();
-  if (!cape.ok()) return {};
-  const int clamped = 2 * setup.columns;
-  for (int i = 0; i < clamped; ++i)
-    cape.pin(static_cast<std::uint32_t>(i), test::row(cape.state().positions, i));
-  const int frames = static_cast<int>(std::lround(setup.seconds * 60.0f));
-  for (int f = 0; f < frames; ++f) cape.step(1.0f / 60.0f, ColliderSpan());
-
-  const Points& x = cape.state().positions;
-  Vec3 edge = Vec3::Zero(), tip = Vec3::Zero();
-  for (int c = 0; c < setup.columns; ++c) {
-    edge += test::row(x, setup.columns + c);
-    tip += test::row(x, (rows - 1) * setup.columns + c);
-  }
-  edge /= static_cast<float>(setup.columns);
-  tip /= static_cast<float>(setup.columns);
-  CantileverResult result;
-  result.theta = std::atan2(edge.y() - tip.y(), tip.x() - edge.x());
-  result.bendingLength =
-      overhang * std::cbrt(std::cos(result.theta / 2.0f) / (8.0f * std::tan(result.theta)));
-  result.maxSpeed = std::sqrt(cape.state().velocities.rowwise().squaredNorm().maxCoeff());
-  return result;
-}
-
-// Peirce's test for every preset at two resolutions, 8 and 16 hinges along the standard overhang L = 2c, with
-// the solver converged (1000 substeps of 10 iterations per 1/60 s: the game's 3 x 1 leaves the strip hanging
-// almost straight down; docs/SOLVER.md, "Fabric presets", has every figure). Issue 17 aims at c within 10 %
-// of (B / w)^(1/3) at both resolutions. The skip-one bend springs do not reach it everywhere (their cubic law
-// and the grid's evenly spread mass both droop the strip more than the fabric): this holds them to 15 % and
-// the two resolutions to 5 % of each other, the state they are in, and checks where they stop: a hinge the
-// bend spring cannot make (stiffer than Y / 2, leather at 16 hinges) bends softer than the fabric.
+// Peirce's cantilever (cape/scenes/Textile.h: ASTM D1388, BS 3356) for every preset at two resolutions, 8
+// and 16 hinges along the standard overhang L = 2c, with the solver converged (200 substeps of 20 iterations
+// per 1/60 s: the game's 3 x 1 leaves the strip drooping more; docs/SOLVER.md, "Fabric presets", has every
+// figure). Issue 17 asks for Peirce's c within 10 % of (B / w)^(1/3) at both resolutions; the linear hinges
+// give 0.3-1.3 %, held here to 3 %, and the two resolutions to 2 % of c of each other.
 CantileverResult convergedCantilever(const FabricMaterial& m, int segments) {
-  CantileverSetup setup;
-  setup.segments = segments;
-  setup.substeps = 1000;
-  setup.iterations = 10;
-  setup.seconds = 1.5f;
-  return cantilever(m, 2.0f * m.bendingLength(), setup);
+  CantileverSpec spec;
+  spec.segments = segments;
+  const CantileverResult r = runCantilever(m, spec);
+  EXPECT_TRUE(r.status.ok()) << r.status.message();
+  return r;
 }
 
 void expectBendingLengthAtTwoResolutions(const char* name) {
   const FabricMaterial& m = *findFabric(name);
   const float c = m.bendingLength();
   float measured[2] = {0.0f, 0.0f};
-  bool capped = false;
   for (int k = 0; k < 2; ++k) {
     const int segments = k == 0 ? 8 : 16;
     const float h = 2.0f * c / static_cast<float>(segments);
@@ -288,17 +188,10 @@ void expectBendingLengthAtTwoResolutions(const char* name) {
                 100 * error);
     ::testing::Test::RecordProperty("bending_length_error_percent_" + std::to_string(segments),
                                     std::to_string(100 * error));
-    EXPECT_LT(r.maxSpeed, 0.1f) << "the strip did not settle";
-    if (std::isfinite(fabricBendStiffness(m, h))) {
-      EXPECT_LT(std::abs(error), 0.15f) << m.name << " at " << segments << " hinges";
-    } else {
-      capped = true;
-      EXPECT_LT(error, -0.15f) << m.name << ": a hinge capped at Y / 2 should bend softer than the fabric";
-    }
+    EXPECT_LT(r.maxSpeed, 0.01f) << "the strip did not settle";
+    EXPECT_LT(std::abs(error), 0.03f) << m.name << " at " << segments << " hinges";
   }
-  if (!capped) {
-    EXPECT_LT(std::abs(measured[1] - measured[0]), 0.05f * c) << "8 and 16 hinges bend apart";
-  }
+  EXPECT_LT(std::abs(measured[1] - measured[0]), 0.02f * c) << "8 and 16 hinges bend apart";
 }
 
 TEST(FabricCantilever, SilkBendsLikeSilkAtTwoResolutions) {
@@ -326,17 +219,18 @@ TEST(FabricCantileverReport, TheCapesSpacingsAndTheGamesSolver) {
     for (float h : {0.02f, 0.01f}) {
       float theta[2] = {0.0f, 0.0f};
       for (int solver : {0, 1}) {
-        CantileverSetup setup;
-        setup.segments = std::max(1, static_cast<int>(std::lround(2.0f * c / h)));
-        setup.substeps = solver ? 1000 : 3;
-        setup.iterations = solver ? 10 : 1;
-        setup.seconds = 1.5f;
-        const float overhang = h * static_cast<float>(setup.segments);
-        const CantileverResult r = cantilever(m, overhang, setup);
+        CantileverSpec spec;
+        spec.segments = std::max(1, static_cast<int>(std::lround(2.0f * c / h)));
+        spec.substeps = solver ? 200 : 3;
+        spec.iterations = solver ? 20 : 1;
+        spec.seconds = 1.5f;
+        spec.overhang = h * static_cast<float>(spec.segments);
+        const CantileverResult r = runCantilever(m, spec);
+        ASSERT_TRUE(r.status.ok()) << r.status.message();
         theta[solver] = r.theta;
         std::printf(
             "cantilever %-8s h %.0f mm  L %.1f cm (%d)  %4d x %2d  theta %.1f deg  c_sim %.2f cm  %+.1f %%\n",
-            m.name.c_str(), 1000 * h, 100 * overhang, setup.segments, setup.substeps, setup.iterations,
+            m.name.c_str(), 1000 * h, 100 * spec.overhang, spec.segments, spec.substeps, spec.iterations,
             r.theta * 57.29578f, 100 * r.bendingLength, 100 * (r.bendingLength / c - 1));
       }
       if (std::lround(2.0f * c / h) >= 3) {

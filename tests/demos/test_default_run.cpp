@@ -321,8 +321,11 @@ TEST(Fabric, APresetSetsTheCapeAndTheSummaryNamesIt) {
     EXPECT_NEAR(s["settings"]["damping_per_s"].get<double>(), m->damping, 1e-6) << name;
     EXPECT_FALSE(s["summary"]["blow_up"].get<bool>()) << name;
   }
-  EXPECT_NE(runs["silk"]["settings"]["bend_stiffness_n_per_m"],
-            runs["denim"]["settings"]["bend_stiffness_n_per_m"]);
+  EXPECT_NEAR(runs["silk"]["settings"]["bending_rigidity_n_m"].get<double>(),
+              findFabric("silk")->bendingRigidity, 1e-12);
+  EXPECT_NE(runs["silk"]["settings"]["bending_rigidity_n_m"],
+            runs["denim"]["settings"]["bending_rigidity_n_m"]);
+  EXPECT_EQ(runs[""]["settings"]["bending_rigidity_n_m"].get<double>(), 0.0);
   EXPECT_NE(runs["silk"]["cape"]["mass_kg"], runs["denim"]["cape"]["mass_kg"]);
   EXPECT_NE(runs["silk"]["settings"]["structural_stiffness_n_per_m"],
             runs[""]["settings"]["structural_stiffness_n_per_m"]);

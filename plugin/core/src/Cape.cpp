@@ -50,6 +50,18 @@ static float explicitStableStep(const Fabric& fabric, const CapeSettings& settin
       bound[set.second[s]] += k * w;
     }
   }
+  if (settings.bendingRigidity > 0.0f) {
+    // A hinge's stiffness matrix is k g g^T with g its gradient: Gershgorin's row sums of M^-1 K.
+    const HingeSet& h = fabric.hinges();
+    for (std::size_t k = 0; k < h.size(); ++k) {
+      const float kk = settings.bendingRigidity * h.areaOverLength2[k];
+      const float a = h.firstWeight[k], b = h.secondWeight[k], ab = a + b;
+      const float sum = a + b + ab;
+      bound[h.first[k]] += kk * a * sum / m[h.first[k]];
+      bound[h.second[k]] += kk * b * sum / m[h.second[k]];
+      bound[h.middle[k]] += kk * ab * sum / m[h.middle[k]];
+    }
+  }
   const float lambdaMax = bound.maxCoeff();
   return lambdaMax > 0.0f ? 2.0f / std::sqrt(lambdaMax) : kInf;
 }
@@ -61,6 +73,7 @@ detail::CapeScratch::CapeScratch(const Fabric& fabric) : body(fabric.particleCou
   airVelocity = Points::Zero(n, 3);
   freeMask = Eigen::VectorXf::Ones(n);
   lambda = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.springCount()));
+  hingeLambda = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.hinges().size()));
   selfWeight = Eigen::VectorXf::Zero(n);
   lost.reserve(static_cast<std::size_t>(n));
 }
@@ -685,10 +698,20 @@ void Cape::solveConstraints(float h) {
   // the colliders.
   // The multipliers start every substep at zero; with one iteration they are never read again, so none is
   // kept (SpringSolveArrays::lambda null).
-  if (settings_.iterations > 1) work_->lambda.setZero();
+  const bool bending = settings_.bendingRigidity > 0.0f && fabric_->hinges().size() > 0;
+  if (settings_.iterations > 1) {
+    work_->lambda.setZero();
+    if (bending) work_->hingeLambda.setZero();
+  }
   for (int it = 0; it < settings_.iterations; ++it) {
     if (settings_.useTethers) solveTethers();
     solveSprings(h);
+    if (bending) {
+      detail::solveHinges(state_.positions.col(0).data(), state_.positions.col(1).data(),
+                          state_.positions.col(2).data(), state_.inverseMasses.data(), fabric_->hinges(),
+                          settings_.bendingRigidity, 1.0f / (h * h),
+                          settings_.iterations > 1 ? work_->hingeLambda.data() : nullptr);
+    }
     if (settings_.selfCollision)
       work_->self.solve(state_.positions, state_.inverseMasses.data(), work_->self.thickness(settings_));
   }
@@ -784,6 +807,8 @@ void Cape::accumulateSpringForces() {
   float* ay = work_->acceleration.col(1).data();
   float* az = work_->acceleration.col(2).data();
   const float* w = state_.inverseMasses.data();
+  if (settings_.bendingRigidity > 0.0f)
+    detail::addHingeForces(px, py, pz, w, fabric_->hinges(), settings_.bendingRigidity, ax, ay, az);
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const float k = stiffnessOf(settings_, f);
     if (k <= 0.0f) continue;
@@ -823,6 +848,8 @@ double Cape::energy() const {
       e += 0.5 * k * ext * ext;
     }
   }
+  if (settings_.bendingRigidity > 0.0f)
+    e += detail::hingeEnergy(state_.positions, fabric_->hinges(), settings_.bendingRigidity);
   return e;
 }
 

@@ -16,6 +16,7 @@ struct CapeScratch {
   Points airVelocity;               ///< The wind's velocity at each particle for this step, m/s.
   Eigen::VectorXf freeMask;         ///< 1 for free particles, 0 for pinned, refreshed each step.
   Eigen::VectorXf lambda;           ///< XPBD Lagrange multipliers of every spring (iterations > 1).
+  Eigen::VectorXf hingeLambda;      ///< XPBD multipliers of the bending hinges (iterations > 1).
   Eigen::VectorXf selfWeight;       ///< Inverse masses for the last self-contact pass, 1/kg.
   std::vector<std::uint32_t> lost;  ///< The numerical guard's finds in one step (capacity: every particle).
   BodyCollision body;

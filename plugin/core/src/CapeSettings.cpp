@@ -43,6 +43,8 @@ Status CapeSettings::validate() const {
     return Status::error("CapeSettings: shearStiffness must be >= 0 N/m (0 disables the family)");
   if (std::isnan(bendStiffness) || bendStiffness < 0.0f)
     return Status::error("CapeSettings: bendStiffness must be >= 0 N/m (0 disables the family)");
+  if (!finiteNonNegative(bendingRigidity))
+    return Status::error("CapeSettings: bendingRigidity must be finite and >= 0 N·m (0 = off)");
   if (integrator == Integrator::ExplicitSpring &&
       (std::isinf(structuralStiffness) || std::isinf(shearStiffness) || std::isinf(bendStiffness)))
     return Status::error("CapeSettings: the explicit integrator needs finite stiffness");

@@ -1,6 +1,7 @@
 #include "cape/core/Fabric.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -183,6 +184,16 @@ FabricResult Fabric::grid(const GridDesc& d) {
       f->triangles_.insert(f->triangles_.end(), {cc, e, b, cc, b, a});
     }
   }
+  if (d.massByArea) {
+    // Each cell of area A gives A / 4 to each corner (the triangles' thirds summed over a cell's two halves
+    // give the same for a square grid's interior; this is exact for any aspect ratio).
+    const float cell = d.totalMass / static_cast<float>((nr - 1) * (nc - 1)) * 0.25f;
+    f->masses_.setZero();
+    for (int r = 0; r + 1 < nr; ++r)
+      for (int c = 0; c + 1 < nc; ++c)
+        for (const std::uint32_t v : {id(r, c), id(r, c + 1), id(r + 1, c), id(r + 1, c + 1)})
+          f->masses_[v] += cell;
+  }
   result.status = f->finish(d.tetherAnchors, d.tethersPerParticle, d.tetherScale);
   if (result.status.ok()) result.fabric = std::move(f);
   return result;
@@ -307,7 +318,75 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
   }
   buildTriangleTables();
   buildComponents();
+  buildHinges();
   return buildTethers(anchors, tethersPerParticle, tetherScale);
+}
+
+void Fabric::buildHinges() {
+  // Each particle's structural neighbours (sorted: deterministic), each one paired with its most opposite
+  // neighbour when the choice is mutual and the two arms are within 20 degrees of a straight line: a
+  // grid's rows and columns, a triangulated grid's diagonals too, a mesh's nearest to straight lines.
+  constexpr float kMinStraightness = -0.94f;  // cos of 160 degrees: the arms' unit vectors dot at most this
+  const std::size_t n = particleCount();
+  const SpringSet& structural = springs_[static_cast<int>(SpringFamily::Structural)];
+  std::vector<std::vector<std::uint32_t>> neighbours(n);
+  for (std::size_t s = 0; s < structural.size(); ++s) {
+    neighbours[structural.first[s]].push_back(structural.second[s]);
+    neighbours[structural.second[s]].push_back(structural.first[s]);
+  }
+  hinges_ = HingeSet();
+  const double totalArea = particleAreas_.cast<double>().sum();
+  const double totalMass = masses_.cast<double>().sum();
+  if (!(totalArea > 0.0) || !(totalMass > 0.0)) return;
+  const double areaPerMass = totalArea / totalMass;
+  std::vector<Vec3> arm;
+  std::vector<std::size_t> best;
+  std::vector<std::array<std::uint32_t, 2>> pairs;
+  for (std::size_t j = 0; j < n; ++j) {
+    std::vector<std::uint32_t>& nb = neighbours[j];
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    if (nb.size() < 2 || nb.size() > kMaxHingeNeighbours) continue;
+    arm.resize(nb.size());
+    for (std::size_t a = 0; a < nb.size(); ++a)
+      arm[a] = (restPositions_.row(nb[a]) - restPositions_.row(static_cast<Eigen::Index>(j)))
+                   .transpose()
+                   .normalized();
+    best.assign(nb.size(), nb.size());
+    for (std::size_t a = 0; a < nb.size(); ++a) {
+      float lowest = kMinStraightness;
+      for (std::size_t b = 0; b < nb.size(); ++b) {
+        const float c = arm[a].dot(arm[b]);
+        if (b != a && c < lowest) {
+          lowest = c;
+          best[a] = b;
+        }
+      }
+    }
+    pairs.clear();
+    for (std::size_t a = 0; a < nb.size(); ++a)
+      if (best[a] > a && best[a] < nb.size() && best[best[a]] == a) pairs.push_back({nb[a], nb[best[a]]});
+    if (pairs.empty()) continue;
+    // One or two hinges (a grid's row and column) each take the whole area: each measures its own
+    // direction's curvature, exactly along it. Three or more (a triangle mesh's) share it as 8 / (3 n): over
+    // every direction a cylinder may bend along, the mean of cos^4 is 3/8, so n hinges then store the
+    // plate's energy on average, and exactly at any angle for an equilateral mesh's three lines.
+    const double share = masses_[static_cast<Eigen::Index>(j)] * areaPerMass *
+                         (pairs.size() <= 2 ? 1.0 : 8.0 / (3.0 * static_cast<double>(pairs.size())));
+    for (const auto& [i, k] : pairs) {
+      const Vec3 xj = restPositions_.row(static_cast<Eigen::Index>(j)).transpose();
+      const Vec3 ei = restPositions_.row(i).transpose() - xj, ek = restPositions_.row(k).transpose() - xj;
+      const float li = ei.norm(), lk = ek.norm();
+      const double mean = 0.5 * (static_cast<double>(li) + lk);
+      hinges_.first.push_back(i);
+      hinges_.middle.push_back(static_cast<std::uint32_t>(j));
+      hinges_.second.push_back(k);
+      hinges_.firstWeight.push_back(1.0f / li);
+      hinges_.secondWeight.push_back(1.0f / lk);
+      hinges_.restBend.push_back((ei / li + ek / lk).norm());
+      hinges_.areaOverLength2.push_back(static_cast<float>(share / (mean * mean)));
+    }
+  }
 }
 
 void Fabric::buildComponents() {

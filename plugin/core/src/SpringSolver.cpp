@@ -295,4 +295,88 @@ void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alph
 
 #endif
 
+namespace {
+
+// The hinge's curvature vector d, its length and C = |d| - restBend.
+struct HingeGeometry {
+  float dx, dy, dz, length, c;
+};
+
+inline HingeGeometry hingeGeometry(const float* px, const float* py, const float* pz, const HingeSet& h,
+                                   std::size_t k) {
+  const std::uint32_t i = h.first[k], j = h.middle[k], l = h.second[k];
+  const float a = h.firstWeight[k], b = h.secondWeight[k];
+  HingeGeometry g;
+  g.dx = a * (px[i] - px[j]) + b * (px[l] - px[j]);
+  g.dy = a * (py[i] - py[j]) + b * (py[l] - py[j]);
+  g.dz = a * (pz[i] - pz[j]) + b * (pz[l] - pz[j]);
+  g.length = std::sqrt(g.dx * g.dx + g.dy * g.dy + g.dz * g.dz);
+  g.c = g.length - h.restBend[k];
+  return g;
+}
+
+}  // namespace
+
+void solveHinges(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
+                 float bendingRigidity, float invH2, float* lambda) {
+  for (std::size_t k = 0; k < hinges.size(); ++k) {
+    const HingeGeometry g = hingeGeometry(px, py, pz, hinges, k);
+    if (!(g.length > 1e-12f) || !std::isfinite(g.length)) continue;
+    const std::uint32_t i = hinges.first[k], j = hinges.middle[k], l = hinges.second[k];
+    const float a = hinges.firstWeight[k], b = hinges.secondWeight[k], ab = a + b;
+    const float wi = inverseMass[i], wj = inverseMass[j], wl = inverseMass[l];
+    // A clamp (the middle and one arm pinned): the pinned half of the hinge's area lies on the support, held
+    // straight, so the hinge bends over its free half only: twice the stiffness.
+    const float clamp = wj == 0.0f && ((wi == 0.0f) != (wl == 0.0f)) ? 2.0f : 1.0f;
+    const float alphaTilde = invH2 / (clamp * bendingRigidity * hinges.areaOverLength2[k]);
+    const float denominator = wi * a * a + wl * b * b + wj * ab * ab + alphaTilde;
+    if (!(denominator > 0.0f)) continue;
+    const float previous = lambda != nullptr ? lambda[k] : 0.0f;
+    const float dLambda = (-g.c - alphaTilde * previous) / denominator;
+    if (lambda != nullptr) lambda[k] = previous + dLambda;
+    const float s = dLambda / g.length;  // along n = d / |d|
+    const float nx = g.dx * s, ny = g.dy * s, nz = g.dz * s;
+    px[i] += wi * a * nx;
+    py[i] += wi * a * ny;
+    pz[i] += wi * a * nz;
+    px[l] += wl * b * nx;
+    py[l] += wl * b * ny;
+    pz[l] += wl * b * nz;
+    px[j] -= wj * ab * nx;
+    py[j] -= wj * ab * ny;
+    pz[j] -= wj * ab * nz;
+  }
+}
+
+void addHingeForces(const float* px, const float* py, const float* pz, const float* inverseMass,
+                    const HingeSet& hinges, float bendingRigidity, float* ax, float* ay, float* az) {
+  for (std::size_t k = 0; k < hinges.size(); ++k) {
+    const HingeGeometry g = hingeGeometry(px, py, pz, hinges, k);
+    if (!(g.length > 1e-12f) || !std::isfinite(g.length)) continue;
+    const std::uint32_t i = hinges.first[k], j = hinges.middle[k], l = hinges.second[k];
+    const float a = hinges.firstWeight[k], b = hinges.secondWeight[k], ab = a + b;
+    const float s = -bendingRigidity * hinges.areaOverLength2[k] * g.c / g.length;  // -k C along n
+    const float fx = g.dx * s, fy = g.dy * s, fz = g.dz * s;
+    ax[i] += inverseMass[i] * a * fx;
+    ay[i] += inverseMass[i] * a * fy;
+    az[i] += inverseMass[i] * a * fz;
+    ax[l] += inverseMass[l] * b * fx;
+    ay[l] += inverseMass[l] * b * fy;
+    az[l] += inverseMass[l] * b * fz;
+    ax[j] -= inverseMass[j] * ab * fx;
+    ay[j] -= inverseMass[j] * ab * fy;
+    az[j] -= inverseMass[j] * ab * fz;
+  }
+}
+
+double hingeEnergy(const Points& positions, const HingeSet& hinges, float bendingRigidity) {
+  double e = 0.0;
+  const float *px = positions.col(0).data(), *py = positions.col(1).data(), *pz = positions.col(2).data();
+  for (std::size_t k = 0; k < hinges.size(); ++k) {
+    const HingeGeometry g = hingeGeometry(px, py, pz, hinges, k);
+    e += 0.5 * static_cast<double>(bendingRigidity) * hinges.areaOverLength2[k] * g.c * g.c;
+  }
+  return e;
+}
+
 }  // namespace cape::detail

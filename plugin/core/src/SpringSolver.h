@@ -50,4 +50,22 @@ void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMas
 /// scalar loop: anchors are never tethered particles, so the four read nothing the others write.
 void solveTethers(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers);
 
+/// The linear bending hinges (Fabric.h's HingeSet) as XPBD constraints C = |d| - restBend, with d the
+/// hinge's curvature vector and the gradients w1 n, w2 n, -(w1 + w2) n at its first, second and middle
+/// particle (n = d / |d|, w1, w2 its arm weights), and the compliance 1 / (bendingRigidity areaOverLength2):
+///   dlambda = (-C - alpha~ lambda) / (m1 w1^2 + m2 w2^2 + mm (w1 + w2)^2 + alpha~),
+/// with m the inverse masses; one hinge after another in the set's order. A hinge with |d| below 1e-12 (a
+/// straight line) has no direction and is left alone. `lambda` may be null, as SpringSolveArrays'.
+/// `invH2` is 1 / h^2.
+void solveHinges(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
+                 float bendingRigidity, float invH2, float* lambda);
+
+/// The hinges' elastic forces for the explicit integrator, -k C grad C with k = bendingRigidity
+/// areaOverLength2, added to the accelerations (times the inverse masses).
+void addHingeForces(const float* px, const float* py, const float* pz, const float* inverseMass,
+                    const HingeSet& hinges, float bendingRigidity, float* ax, float* ay, float* az);
+
+/// The hinges' elastic energy, J: sum of 1/2 k C^2.
+double hingeEnergy(const Points& positions, const HingeSet& hinges, float bendingRigidity);
+
 }  // namespace cape::detail

@@ -52,6 +52,11 @@ struct CAPE_CORE_API CapeSettings {
   float shearStiffness = 2.0e3f;  ///< N/m per shear spring (see structuralStiffness).
   float bendStiffness = 20.0f;    ///< N/m per bend spring (see structuralStiffness).
   bool useTethers = true;         ///< Long-range attachments to pinned anchors (XPBD only).
+  /// Linear bending, N·m: the fabric's flexural rigidity per unit width (bending moment per width per unit
+  /// curvature, KES-F's B), resisted at every hinge of Fabric::hinges() with a moment linear in its angle,
+  /// so a coarse and a fine grid bend alike (applyFabric sets it from a FabricMaterial). 0, the default, is
+  /// off: the bend springs are the seed's bending.
+  float bendingRigidity = 0.0f;
 
   /// Linear velocity damping, 1/s: dv/dt = -damping * v (applied as v /= 1 + damping * h). Stands in for
   /// the air's drag when no aerodynamic wind model is on: a 0.4 kg, 0.6 m^2 cape moving at 1 m/s through

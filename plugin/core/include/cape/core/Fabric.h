@@ -75,13 +75,44 @@ struct TetherSet {
   std::size_t size() const { return particle.size(); }
 };
 
+/// The hinges of the linear bending model (CapeSettings::bendingRigidity): three particles `first`, `middle`,
+/// `second` in a straight line at rest, joined by structural springs (a grid's rows and columns, a mesh's
+/// edges through a vertex to its most opposite neighbour). The hinge's curvature vector is
+/// d = (x_first - x_middle) / L1 + (x_second - x_middle) / L2 (L1, L2 the arms' rest lengths): linear in the
+/// positions, 0 on a straight line whatever the arms, |d| = 2 sin(theta / 2) for a hinge bent by theta. Its
+/// energy, 1/2 B areaOverLength2 (|d| - restBend)^2, is the plate's 1/2 B kappa^2 over the hinge's area, so
+/// a coarse and a fine grid of one fabric bend alike (docs/SOLVER.md, "Linear bending").
+struct HingeSet {
+  std::vector<std::uint32_t> first;   ///< One end of each hinge.
+  std::vector<std::uint32_t> middle;  ///< The particle it bends at.
+  std::vector<std::uint32_t> second;  ///< The other end.
+  std::vector<float> firstWeight;     ///< 1 / L1, 1/m.
+  std::vector<float> secondWeight;    ///< 1 / L2, 1/m.
+  std::vector<float> restBend;        ///< |d| at rest (0 for a straight hinge).
+  /// The hinge's area over its mean arm length squared (dimensionless): its stiffness is B times this (N·m).
+  /// The area is the middle particle's share of the fabric (its mass over the fabric's mean mass per area):
+  /// whole for each of one or two hinges (a grid's row and column, exact along them; on the bias a grid is
+  /// half as stiff), 8 / (3 n) of it for each of n >= 3 (exact in every direction on an equilateral mesh).
+  std::vector<float> areaOverLength2;
+  /// The number of hinges.
+  std::size_t size() const { return first.size(); }
+};
+
+/// A vertex with more neighbours than this gets no hinges (its neighbours are paired in time quadratic in
+/// their number; a real cloth mesh has 4 to 8).
+constexpr std::size_t kMaxHingeNeighbours = 32;
+
 /// How to build a rectangular grid fabric.
 struct GridDesc {
-  int columns = 20;         ///< Particles per row (>= 2).
-  int rows = 20;            ///< Particles per column (>= 2).
-  float width = 0.6f;       ///< m, along +X of the grid's local frame.
-  float height = 1.0f;      ///< m, along -Y: row 0 is the top.
-  float totalMass = 0.4f;   ///< kg, spread evenly over the particles.
+  int columns = 20;        ///< Particles per row (>= 2).
+  int rows = 20;           ///< Particles per column (>= 2).
+  float width = 0.6f;      ///< m, along +X of the grid's local frame.
+  float height = 1.0f;     ///< m, along -Y: row 0 is the top.
+  float totalMass = 0.4f;  ///< kg, spread evenly over the particles (or by area: massByArea).
+  /// Spread the mass in proportion to each particle's share of the area, as a cloth's own weight is (edge
+  /// particles half, corners a quarter of an interior one), instead of evenly (the canonical cape's, which
+  /// gives the grid's border a tile beyond it). What a textile test of a strip measures (FabricPresets.h).
+  bool massByArea = false;
   bool bendSprings = true;  ///< Add bend springs: every second particle along rows and columns.
   /// Particles to which tethers are made (usually the particles that will be pinned). Empty: no tethers.
   std::vector<std::uint32_t> tetherAnchors;
@@ -157,6 +188,9 @@ class CAPE_CORE_API Fabric {
   std::size_t springCount() const;  ///< All families together.
   /// The long-range attachments (empty without tether anchors).
   const TetherSet& tethers() const { return tethers_; }
+  /// The hinges of the linear bending model, in solver order (built for every fabric; used when
+  /// CapeSettings::bendingRigidity > 0).
+  const HingeSet& hinges() const { return hinges_; }
   const std::vector<std::uint32_t>& triangles() const { return triangles_; }  ///< 3 per triangle, CCW.
   /// The number of triangles.
   std::size_t triangleCount() const { return triangles_.size() / 3; }
@@ -196,6 +230,7 @@ class CAPE_CORE_API Fabric {
   Status buildTethers(const std::vector<std::uint32_t>& anchors, int tethersPerParticle, float tetherScale);
   void buildTriangleTables();
   void buildComponents();
+  void buildHinges();
 
   float meanSpacing_ = 0.0f;
   Eigen::VectorXf particleAreas_;
@@ -207,6 +242,7 @@ class CAPE_CORE_API Fabric {
   Eigen::VectorXf masses_;
   SpringSet springs_[kSpringFamilyCount];
   TetherSet tethers_;
+  HingeSet hinges_;
   std::vector<std::uint32_t> triangles_;
   std::vector<Eigen::Vector2f> uvs_;
   int gridColumns_ = 0;

@@ -50,8 +50,10 @@ CAPE_CORE_API const FabricMaterial* findFabric(std::string_view name);
 CAPE_CORE_API std::string fabricNames();
 
 /// The settings of a cape of material `m` on a grid whose rest spacing is `spacing` (m; Fabric::meanSpacing()
-/// of a square grid): per-spring structural, shear and bend stiffness derived from the material for that
-/// spacing, the fabric's damping and the wind's drag and lift coefficients; every other field is `base`'s.
+/// of a square grid): per-spring structural and shear stiffness derived from the material (for a square
+/// cell they do not depend on the spacing), the linear bending's rigidity (`bendingRigidity` = the
+/// material's B, the bend springs off: `bendStiffness` 0), the fabric's damping and the wind's drag and lift
+/// coefficients; every other field is `base`'s.
 /// Bad input (an invalid material, spacing not finite and > 0) returns `base` unchanged: checkFabric() says
 /// why.
 CAPE_CORE_API CapeSettings applyFabric(const FabricMaterial& m, float spacing,
@@ -70,13 +72,4 @@ CAPE_CORE_API float fabricMass(const FabricMaterial& m, float width, float heigh
 CAPE_CORE_API float fabricStructuralStiffness(const FabricMaterial& m, float spacing);
 /// The shear family's per-spring stiffness, N/m (see fabricStructuralStiffness).
 CAPE_CORE_API float fabricShearStiffness(const FabricMaterial& m, float spacing);
-/// The stiffness a skip-one bend spring's hinge must have, N/m: 8 B c^2 / h^4 with c the bending length and h
-/// the spacing, which matches the spring's cubic moment law to the fabric's B at the curvature 1/c
-/// (docs/SOLVER.md, "Fabric presets").
-CAPE_CORE_API float fabricHingeStiffness(const FabricMaterial& m, float spacing);
-/// The bend spring's own stiffness, N/m: the hinge's, less the give of the two segments it spans, in series
-/// (1 / k = 1 / k_hinge - 2 / Y); infinite where the hinge must be stiffer than Y / 2, which a spring cannot
-/// give.
-CAPE_CORE_API float fabricBendStiffness(const FabricMaterial& m, float spacing);
-
 }  // namespace cape
