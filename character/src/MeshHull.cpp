@@ -869,6 +869,10 @@ MeshHullResult loadUncaught(const std::string& path, const Vec3& scale, const Me
 
 }  // namespace
 
+Status precheckMeshFile(const std::string& path) {
+  return precheck(path);
+}
+
 Status resolveMeshUri(const std::string& uri, const std::string& baseDir,
                       const std::vector<std::string>& packagePaths, std::string& resolvedPath) {
   resolvedPath.clear();

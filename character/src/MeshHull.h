@@ -83,6 +83,10 @@ Status resolveMeshUri(const std::string& uri, const std::string& baseDir,
 MeshHullResult loadMeshHull(const std::string& path, const Eigen::Vector3d& scale,
                             const MeshHullOptions& options = {});
 
+/// The checks made before assimp reads a file (the COLLADA hazards listed at loadMeshHull): success for any
+/// file that is not read as COLLADA, else InvalidModel naming the problem.
+Status precheckMeshFile(const std::string& path);
+
 /// Empties loadMeshHull's cache (hulls already handed out stay valid: they are shared).
 void clearMeshHullCache();
 

@@ -3,6 +3,7 @@
 // updateAction calls in it (every cape's prepare and advance, on however many workers), timed from outside;
 // the rest of stepSimulation is Bullet's own.
 #include "BulletScene.h"
+#include "ImageFile.h"
 
 #include "cape/bullet/CapeAction.h"
 #include "cape/bullet/CapeGroup.h"
@@ -78,6 +79,15 @@ class BulletCapeRun final : public SceneRun {
     return true;
   }
 
+  /// The same motion constraints on every character's cape (one fabric: one weight map fits them all).
+  Status setMotionConstraints(const MotionConstraints& constraints) {
+    for (auto& c : capes_) {
+      Status s = c->cape().setMotionConstraints(constraints);
+      if (!s.ok()) return s;
+    }
+    return Status::success();
+  }
+
   int characterCount() const override { return scene_->characterCount(); }
   void advanceFrame() override {
     ++frame_;
@@ -136,6 +146,22 @@ std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& e
   for (const std::string& n : scene->notes()) std::printf("cape_walk: %s\n", n.c_str());
   auto run = std::make_unique<BulletCapeRun>(std::move(scene), options.threads);
   if (!run->build(run->settings(), options.scene, error)) return nullptr;
+  if (!options.maxDistanceMap.empty()) {
+    GrayImage image;
+    if (!readGrayPng(options.maxDistanceMap, image, error)) return nullptr;
+    const WeightMapResult map = weightMapFromImage(run->cape(0).fabric(), image, options.maxDistanceRange[0],
+                                                   options.maxDistanceRange[1]);
+    if (!map) {
+      error = "--max-distance-map: " + map.status.message();
+      return nullptr;
+    }
+    MotionConstraints constraints;
+    constraints.maxDistance = map.values;
+    if (Status s = run->setMotionConstraints(constraints); !s.ok()) {
+      error = "--max-distance-map: " + s.message();
+      return nullptr;
+    }
+  }
   return run;
 }
 

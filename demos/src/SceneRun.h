@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -54,6 +55,11 @@ struct RunOptions {
   std::string motion;  ///< a motion clip played instead of the gait (empty: the procedural gait)
   character::MotionLoadOptions motionLoad;  ///< its format and the format's options
   character::PlaybackSettings playback;     ///< speed, start, in place
+  /// A grayscale PNG painted over the cape's UVs (--max-distance-map, read by ImageFile.h's readGrayPng):
+  /// each particle's max distance from its animated position (MotionConstraints), black
+  /// maxDistanceRange[0] and white maxDistanceRange[1], m. Empty: no motion constraints.
+  std::string maxDistanceMap;
+  std::array<float, 2> maxDistanceRange{0.0f, 0.1f};  ///< m, black and white of maxDistanceMap
 };
 
 /// The most particles along a side of the cape (--size and the rows that --width and --height make).

@@ -77,6 +77,16 @@ int main(int argc, char** argv) {
   std::int64_t framesEvery = 1;
   bool writeFrames = false, noFrames = false, noRender = false, selfCollision = false;
   addSceneOptions(app, sceneCli);
+  std::string maxDistanceMap;
+  std::vector<double> maxDistanceRange = {0.0, 0.1};
+  app.add_option("--max-distance-map", maxDistanceMap,
+                 "a grayscale PNG painted over the cape's UVs (v = 0 at the top row): each particle's max "
+                 "distance from its animated pose, black to white over --max-distance (Cape::"
+                 "setMotionConstraints)");
+  app.add_option("--max-distance", maxDistanceRange, "the max distance of black and of white, m: LO HI")
+      ->expected(2)
+      ->transform(strictReal(0.0, 10.0))
+      ->capture_default_str();
   app.add_option("--solver", solver, "xpbd (default) | explicit (the seed's explicit springs)")
       ->check(CLI::IsMember({"xpbd", "explicit"}))
       ->capture_default_str();
@@ -124,6 +134,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   o.threads = threads;
+  o.maxDistanceMap = maxDistanceMap;
+  o.maxDistanceRange = {static_cast<float>(maxDistanceRange[0]), static_cast<float>(maxDistanceRange[1])};
   if (!gltf.empty() && o.characters > kMaxGltfCharacters) {
     std::fprintf(stderr,
                  "cape_walk: --gltf keeps every frame of every cape in memory until the run ends: a crowd of "
@@ -240,6 +252,9 @@ int main(int argc, char** argv) {
   // The lowest particle above the ground over the run (m; the ground is the plane through the origin normal
   // to the world's up): a cape that hangs on the back stays well above it.
   double lowest = std::numeric_limits<double>::infinity();
+  // With --max-distance-map: the farthest any particle got from its animated position, and the most it
+  // went beyond its max distance (m, every character, every frame).
+  double animatedDistanceMax = 0.0, maxDistanceExcess = 0.0;
   const Vec3 up = run->up();
   for (std::int64_t f = 1; f <= frames && !blowUp; ++f) {
     run->advanceFrame();
@@ -265,6 +280,16 @@ int main(int argc, char** argv) {
         const FoldStats fold = folds.measure(cape.fabric(), cape.state().positions);
         m.meanDihedral = fold.meanDihedral;
         m.dihedralChange = fold.meanChange;
+      }
+      if (!o.maxDistanceMap.empty() && cape.animatedPositions().rows() == cape.state().positions.rows()) {
+        const Eigen::VectorXf d = (cape.state().positions - cape.animatedPositions()).rowwise().norm();
+        const Eigen::VectorXf& limit = cape.motionConstraints().maxDistance;
+        for (Eigen::Index i = 0; i < d.size(); ++i) {
+          if (!(cape.state().inverseMasses[i] > 0.0f)) continue;  // pins are left alone
+          animatedDistanceMax = std::max(animatedDistanceMax, static_cast<double>(d[i]));
+          if (i < limit.size())
+            maxDistanceExcess = std::max(maxDistanceExcess, static_cast<double>(d[i] - limit[i]));
+        }
       }
       recorders[static_cast<std::size_t>(k)].add(m);
       row.metrics = k == 0 ? m : worstOf(row.metrics, m);  // a crowd's row holds the worst of its characters
@@ -362,6 +387,13 @@ int main(int argc, char** argv) {
   summary["summary"] = summaryFigures(timings, q);
   summary["summary"].update(frameShareFigures(timings, run->characterCount()));
   summary["summary"]["lowest_particle_m"] = std::isfinite(lowest) ? lowest : 0.0;
+  summary["motion_constraints"] =
+      o.maxDistanceMap.empty()
+          ? nlohmann::json()
+          : nlohmann::json{{"max_distance_map", o.maxDistanceMap},
+                           {"max_distance_range_m", {o.maxDistanceRange[0], o.maxDistanceRange[1]}},
+                           {"animated_distance_max_m", animatedDistanceMax},
+                           {"max_distance_excess_m", maxDistanceExcess}};
   summary["up"] = o.up == character::UpAxis::Z ? "z" : "y";
   summary["scene_build_s"] = buildSeconds;
   summary["bullet_objects"] = run->worldObjectCount();
