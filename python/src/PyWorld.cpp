@@ -567,6 +567,14 @@ void World::setMotionConstraints(int cape, const cape::MotionConstraints& constr
   if (!s.ok()) fail(s.message());
 }
 
+void World::setWeightScale(int cape, bool mass, const Eigen::VectorXf& scale) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  checkCape(cape);
+  cape::Cape& c = capes_[static_cast<std::size_t>(cape)]->action->cape();
+  const cape::Status s = mass ? c.setMassScale(scale) : c.setStiffnessScale(scale);
+  if (!s.ok()) fail(s.message());
+}
+
 cape::Points World::capeAnimatedPositions(int cape) const {
   std::lock_guard<std::mutex> lock(mutex_);
   checkCape(cape);

@@ -136,6 +136,8 @@ class World {
   cape::CapeSettings capeSettings(int cape) const;
   void setCapeSettings(int cape, const cape::CapeSettings& settings);
   /// Cape::setMotionConstraints; a ValueError with the library's message on bad arrays.
+  /// Cape::setMassScale (mass true) or setStiffnessScale: ValueError on bad values, the old scale kept.
+  void setWeightScale(int cape, bool mass, const Eigen::VectorXf& scale);
   void setMotionConstraints(int cape, const cape::MotionConstraints& constraints);
   /// Each particle's animated position of the last step (Cape::animatedPositions), m, world.
   cape::Points capeAnimatedPositions(int cape) const;

@@ -16,6 +16,23 @@ using namespace py::literals;
 namespace capepy {
 namespace {
 
+// None: empty (off); a number: the same for every one of n particles; else one value per particle (a 1-D
+// array, a weight map). ValueError for anything else.
+Eigen::VectorXf perParticle(const py::object& o, Eigen::Index n, const char* name) {
+  Eigen::VectorXf v;
+  if (o.is_none()) return v;
+  if (py::isinstance<py::float_>(o) || py::isinstance<py::int_>(o)) {
+    v = Eigen::VectorXf::Constant(n, o.cast<float>());
+    return v;
+  }
+  const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(o);
+  if (!a || a.ndim() != 1)
+    throw py::value_error(std::string(name) + " must be None, a number or a 1-D array of " +
+                          std::to_string(n) + " values");
+  v = Eigen::Map<const Eigen::VectorXf>(a.data(), a.shape(0));
+  return v;
+}
+
 using WorldPtr = std::shared_ptr<World>;
 
 /// Handles: a world and an index. Python may keep them as long as it likes; they keep their world alive.
@@ -327,18 +344,7 @@ void bindHandles(py::module_& m) {
             const Eigen::Index n = c.world->capePositions(c.index).rows();
             // None: off; a number: the same for every particle; else one value per particle (a weight map).
             const auto values = [n](const py::object& o, const char* name) {
-              Eigen::VectorXf v;
-              if (o.is_none()) return v;
-              if (py::isinstance<py::float_>(o) || py::isinstance<py::int_>(o)) {
-                v = Eigen::VectorXf::Constant(n, o.cast<float>());
-                return v;
-              }
-              const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(o);
-              if (!a || a.ndim() != 1)
-                throw py::value_error(std::string(name) + " must be None, a number or a 1-D array of " +
-                                      std::to_string(n) + " values");
-              v = Eigen::Map<const Eigen::VectorXf>(a.data(), a.shape(0));
-              return v;
+              return perParticle(o, n, name);
             };
             cape::MotionConstraints m;
             m.maxDistance = values(maxDistance, "max_distance");
@@ -354,6 +360,26 @@ void bindHandles(py::module_& m) {
           "backstop_radius and backstop_distance (m: a sphere behind the animated surface), drive (0..1 per "
           "1/60 s). Each None (off), a number (every particle) or one value per particle (a weight map, e.g. "
           "from the uvs). ValueError on bad values; the old constraints are kept then.")
+      .def(
+          "set_mass_scale",
+          [](const CapeHandle& c, const py::object& scale) {
+            c.world->setWeightScale(c.index, true,
+                                    perParticle(scale, c.world->capePositions(c.index).rows(), "scale"));
+          },
+          "scale"_a,
+          "Each particle's mass times scale (None: the fabric's masses; a number: every particle; or one "
+          "value "
+          "per particle, a weight map), in (0, 1e6]. ValueError on bad values; the old scale is kept then.")
+      .def(
+          "set_stiffness_scale",
+          [](const CapeHandle& c, const py::object& scale) {
+            c.world->setWeightScale(c.index, false,
+                                    perParticle(scale, c.world->capePositions(c.index).rows(), "scale"));
+          },
+          "scale"_a,
+          "Each spring's stiffness times the mean of its ends' scale, each bending hinge's times its "
+          "middle's "
+          "(None: unscaled; a number; or one value per particle), in (0, 1e6]. ValueError on bad values.")
       .def_property_readonly(
           "normals", [](const CapeHandle& c) { return pointsToArray(c.world->capeNormals(c.index)); },
           "(N, 3) float32 unit area-weighted vertex normals.")

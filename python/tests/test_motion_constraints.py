@@ -52,3 +52,32 @@ def test_a_drive_of_one_holds_the_animated_pose_and_bad_values_raise():
     for _ in shaken(cape, world, left, right, 30):
         pass
     assert np.abs(cape.positions - cape.animated_positions).max() > 0.01
+
+
+def test_mass_and_stiffness_weight_maps_reach_the_cape():
+    def hang(mass=None, stiffness=None):
+        world = capecloth.World()
+        left = world.add_sphere(0.08, pose=[-0.22, 1.52, 0, 0, 0, 0, 1])
+        right = world.add_sphere(0.08, pose=[0.22, 1.52, 0, 0, 0, 0, 1])
+        cape = world.add_cape([left, right])
+        if mass is not None:
+            cape.set_mass_scale(mass(cape))
+        if stiffness is not None:
+            cape.set_stiffness_scale(stiffness(cape))
+        for _ in range(60):
+            world.step()
+        return cape
+
+    plain = hang()
+    ones = hang(mass=lambda c: 1.0, stiffness=lambda c: np.ones(len(c.uvs)))
+    assert np.array_equal(plain.positions, ones.positions)  # a scale of one changes no bit
+    heavy_hem = hang(mass=lambda c: 1.0 + 9.0 * c.uvs[:, 1])  # ten times heavier at the hem (v = 1)
+    assert not np.array_equal(plain.positions, heavy_hem.positions)
+    with pytest.raises(ValueError, match="setMassScale"):
+        plain.set_mass_scale(np.zeros(len(plain.uvs)))
+    with pytest.raises(ValueError, match="setStiffnessScale"):
+        plain.set_stiffness_scale(np.ones(3))
+    with pytest.raises(ValueError):
+        plain.set_stiffness_scale(np.ones((2, 2)))
+    plain.set_mass_scale(None)
+    plain.set_stiffness_scale(None)

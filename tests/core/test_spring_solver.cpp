@@ -146,7 +146,8 @@ KernelState jittered(const Fabric& fabric, unsigned seed) {
   return st;
 }
 
-void solveAll(const Fabric& fabric, KernelState& st, bool vector, bool keepLambda = true) {
+void solveAll(const Fabric& fabric, KernelState& st, bool vector, bool keepLambda = true,
+              const std::vector<float>* complianceScale = nullptr) {
   std::size_t offset = 0;
   for (int family = 0; family < kSpringFamilyCount; ++family) {
     const SpringSet& set = fabric.springs(static_cast<SpringFamily>(family));
@@ -159,6 +160,7 @@ void solveAll(const Fabric& fabric, KernelState& st, bool vector, bool keepLambd
     a.second = set.second.data();
     a.restLength = set.restLength.data();
     a.lambda = keepLambda ? st.lambda.data() + offset : nullptr;
+    a.complianceScale = complianceScale != nullptr ? complianceScale->data() + offset : nullptr;
     const float alphaTilde = 0.01f * static_cast<float>(family + 1);
     if (vector) {
       for (const SpringRun& run : set.runs) detail::solveSpringRun(a, run, alphaTilde);
@@ -209,6 +211,33 @@ TEST(SpringSolver, VectorRunsGiveTheScalarLoopsBits) {
     // And the springs did work: the jittered cape moved.
     const KernelState start = jittered(*fabric, 7);
     EXPECT_FALSE(sameBits(vector.y, start.y));
+  }
+}
+
+TEST(SpringSolver, ScaledComplianceGivesTheScalarLoopsBitsAndOneChangesNoBit) {
+  // Per-spring compliance scales (Cape::setStiffnessScale): the vector runs still give the scalar loop's
+  // bits, with and without multipliers; a scale of exactly 1 everywhere gives the unscaled kernels' bits;
+  // and a real scale moves the particles elsewhere.
+  for (const FabricPtr& fabric : fabrics()) {
+    ASSERT_TRUE(fabric);
+    std::vector<float> scale(fabric->springCount()), ones(fabric->springCount(), 1.0f);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(0.05f, 20.0f);
+    for (float& v : scale) v = u(rng);
+    for (const bool keep : {true, false}) {
+      KernelState vector = jittered(*fabric, 5), scalar = vector, unit = vector, plain = vector;
+      for (int iteration = 0; iteration < 5; ++iteration) {
+        solveAll(*fabric, vector, true, keep, &scale);
+        solveAll(*fabric, scalar, false, keep, &scale);
+        solveAll(*fabric, unit, true, keep, &ones);
+        solveAll(*fabric, plain, true, keep, nullptr);
+      }
+      EXPECT_TRUE(sameBits(vector.x, scalar.x) && sameBits(vector.y, scalar.y) &&
+                  sameBits(vector.z, scalar.z));
+      EXPECT_TRUE(sameBits(vector.lambda, scalar.lambda));
+      EXPECT_TRUE(sameBits(unit.x, plain.x) && sameBits(unit.y, plain.y) && sameBits(unit.z, plain.z));
+      EXPECT_FALSE(sameBits(vector.y, plain.y));
+    }
   }
 }
 

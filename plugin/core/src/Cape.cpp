@@ -37,14 +37,20 @@ float stiffnessOf(const CapeSettings& s, int family) {
 /// The largest substep the explicit integrator can take without blowing up. Symplectic Euler on a linear
 /// spring system is stable while h * omega_max < 2, i.e. h^2 * lambda_max(M^-1 K) < 4; Gershgorin's theorem
 /// bounds lambda_max by max over particles i of sum over springs (i, j) of k * (w_i + w_j).
-static float explicitStableStep(const Fabric& fabric, const CapeSettings& settings) {
+/// With a mass scale and a stiffness scale (Cape::setMassScale, setStiffnessScale; empty: none).
+static float explicitStableStep(const Fabric& fabric, const CapeSettings& settings,
+                                const Eigen::VectorXf& massScale = Eigen::VectorXf(),
+                                const Eigen::VectorXf& stiffnessScale = Eigen::VectorXf()) {
   Eigen::VectorXf bound = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(fabric.particleCount()));
-  const Eigen::VectorXf& m = fabric.masses();
+  const Eigen::VectorXf m =
+      massScale.size() > 0 ? Eigen::VectorXf(fabric.masses().cwiseProduct(massScale)) : fabric.masses();
+  const auto scaleOf = [&](std::uint32_t i) { return stiffnessScale.size() > 0 ? stiffnessScale[i] : 1.0f; };
   for (int f = 0; f < kSpringFamilyCount; ++f) {
-    const float k = stiffnessOf(settings, f);
-    if (k <= 0.0f) continue;
+    const float k0 = stiffnessOf(settings, f);
+    if (k0 <= 0.0f) continue;
     const SpringSet& set = fabric.springs(static_cast<SpringFamily>(f));
     for (std::size_t s = 0; s < set.size(); ++s) {
+      const float k = k0 * 0.5f * (scaleOf(set.first[s]) + scaleOf(set.second[s]));
       const float w = 1.0f / m[set.first[s]] + 1.0f / m[set.second[s]];
       bound[set.first[s]] += k * w;
       bound[set.second[s]] += k * w;
@@ -54,7 +60,7 @@ static float explicitStableStep(const Fabric& fabric, const CapeSettings& settin
     // A hinge's stiffness matrix is k g g^T with g its gradient: Gershgorin's row sums of M^-1 K.
     const HingeSet& h = fabric.hinges();
     for (std::size_t k = 0; k < h.size(); ++k) {
-      const float kk = settings.bendingRigidity * h.areaOverLength2[k];
+      const float kk = settings.bendingRigidity * h.areaOverLength2[k] * scaleOf(h.middle[k]);
       const float a = h.firstWeight[k], b = h.secondWeight[k], ab = a + b;
       const float sum = a + b + ab;
       bound[h.first[k]] += kk * a * sum / m[h.first[k]];
@@ -242,7 +248,7 @@ Status Cape::setSettings(const CapeSettings& settings) {
   Status s = settings.validate();
   if (!s.ok()) return s;
   if (settings.integrator == Integrator::ExplicitSpring) {
-    const float hMax = explicitStableStep(*fabric_, settings);
+    const float hMax = explicitStableStep(*fabric_, settings, massScale_, stiffnessScale_);
     const float h = settings.timeStep / static_cast<float>(settings.substeps);
     if (h >= hMax) {
       return Status::error("CapeSettings: the explicit integrator is unstable for this fabric: substep " +
@@ -282,8 +288,74 @@ void Cape::unpin(std::uint32_t particle) {
   if (it == state_.pins.end()) return;
   wake();
   state_.pins.erase(it);
-  state_.inverseMasses[particle] = 1.0f / fabric_->masses()[particle];
+  state_.inverseMasses[particle] =
+      1.0f / (fabric_->masses()[particle] * (massScale_.size() > 0 ? massScale_[particle] : 1.0f));
   markPinnedComponents();
+}
+
+namespace {
+
+// A per-particle scale's checks (setMassScale, setStiffnessScale): empty, or one finite value in (0, 1e6]
+// per particle.
+Status checkScale(const char* what, const Eigen::VectorXf& scale, std::size_t particles) {
+  if (scale.size() == 0) return Status::success();
+  if (static_cast<std::size_t>(scale.size()) != particles)
+    return Status::error(std::string("Cape::") + what + ": " + std::to_string(scale.size()) + " values for " +
+                         std::to_string(particles) + " particles");
+  for (Eigen::Index i = 0; i < scale.size(); ++i)
+    if (!(std::isfinite(scale[i]) && scale[i] > 0.0f && scale[i] <= 1e6f))
+      return Status::error(std::string("Cape::") + what + ": value " + std::to_string(i) +
+                           " is not finite in (0, 1e6]");
+  return Status::success();
+}
+
+}  // namespace
+
+Status Cape::checkExplicitStability(const Eigen::VectorXf& massScale,
+                                    const Eigen::VectorXf& stiffnessScale) const {
+  if (settings_.integrator != Integrator::ExplicitSpring) return Status::success();
+  const float hMax = explicitStableStep(*fabric_, settings_, massScale, stiffnessScale);
+  const float h = settings_.timeStep / static_cast<float>(settings_.substeps);
+  if (h >= hMax)
+    return Status::error("Cape: the explicit integrator would be unstable with this scale: substep " +
+                         std::to_string(h) + " s >= stability bound " + std::to_string(hMax) + " s");
+  return Status::success();
+}
+
+Status Cape::setMassScale(const Eigen::VectorXf& scale) {
+  if (!ok()) return status_;
+  if (Status s = checkScale("setMassScale", scale, fabric_->particleCount()); !s.ok()) return s;
+  if (Status s = checkExplicitStability(scale, stiffnessScale_); !s.ok()) return s;
+  wake();
+  massScale_ = scale;
+  const Eigen::VectorXf& m = fabric_->masses();
+  for (Eigen::Index i = 0; i < state_.inverseMasses.size(); ++i)
+    state_.inverseMasses[i] = 1.0f / (m[i] * (massScale_.size() > 0 ? massScale_[i] : 1.0f));
+  for (const Pin& p : state_.pins) state_.inverseMasses[p.particle] = 0.0f;
+  return Status::success();
+}
+
+Status Cape::setStiffnessScale(const Eigen::VectorXf& scale) {
+  if (!ok()) return status_;
+  if (Status s = checkScale("setStiffnessScale", scale, fabric_->particleCount()); !s.ok()) return s;
+  if (Status s = checkExplicitStability(massScale_, scale); !s.ok()) return s;
+  wake();
+  stiffnessScale_ = scale;
+  springComplianceScale_.resize(0);
+  hingeStiffnessScale_.resize(0);
+  if (scale.size() == 0) return Status::success();
+  springComplianceScale_.resize(static_cast<Eigen::Index>(fabric_->springCount()));
+  Eigen::Index at = 0;
+  for (int f = 0; f < kSpringFamilyCount; ++f) {
+    const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
+    for (std::size_t s = 0; s < set.size(); ++s)
+      springComplianceScale_[at++] = 1.0f / (0.5f * (scale[set.first[s]] + scale[set.second[s]]));
+  }
+  const HingeSet& h = fabric_->hinges();
+  hingeStiffnessScale_.resize(static_cast<Eigen::Index>(h.size()));
+  for (std::size_t k = 0; k < h.size(); ++k)
+    hingeStiffnessScale_[static_cast<Eigen::Index>(k)] = scale[h.middle[k]];
+  return Status::success();
 }
 
 void Cape::movePin(std::size_t k, const Vec3& target) {
@@ -710,7 +782,8 @@ void Cape::solveConstraints(float h) {
       detail::solveHinges(state_.positions.col(0).data(), state_.positions.col(1).data(),
                           state_.positions.col(2).data(), state_.inverseMasses.data(), fabric_->hinges(),
                           settings_.bendingRigidity, 1.0f / (h * h),
-                          settings_.iterations > 1 ? work_->hingeLambda.data() : nullptr);
+                          settings_.iterations > 1 ? work_->hingeLambda.data() : nullptr,
+                          hingeStiffnessScale_.size() > 0 ? hingeStiffnessScale_.data() : nullptr);
     }
     if (settings_.selfCollision)
       work_->self.solve(state_.positions, state_.inverseMasses.data(), work_->self.thickness(settings_));
@@ -765,6 +838,7 @@ void Cape::solveSprings(float h) {
   arrays.pz = state_.positions.col(2).data();
   arrays.inverseMass = state_.inverseMasses.data();
   arrays.lambda = settings_.iterations > 1 ? work_->lambda.data() : nullptr;
+  arrays.complianceScale = springComplianceScale_.size() > 0 ? springComplianceScale_.data() : nullptr;
   const float invH2 = 1.0f / (h * h);
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
@@ -776,6 +850,7 @@ void Cape::solveSprings(float h) {
       for (const SpringRun& run : set.runs) detail::solveSpringRun(arrays, run, compliance * invH2);
     }
     if (arrays.lambda != nullptr) arrays.lambda += set.size();
+    if (arrays.complianceScale != nullptr) arrays.complianceScale += set.size();
   }
 }
 
@@ -808,16 +883,22 @@ void Cape::accumulateSpringForces() {
   float* az = work_->acceleration.col(2).data();
   const float* w = state_.inverseMasses.data();
   if (settings_.bendingRigidity > 0.0f)
-    detail::addHingeForces(px, py, pz, w, fabric_->hinges(), settings_.bendingRigidity, ax, ay, az);
+    detail::addHingeForces(px, py, pz, w, fabric_->hinges(), settings_.bendingRigidity, ax, ay, az,
+                           hingeStiffnessScale_.size() > 0 ? hingeStiffnessScale_.data() : nullptr);
+  const float* springScale = springComplianceScale_.size() > 0 ? springComplianceScale_.data() : nullptr;
+  std::size_t offset = 0;  // of the family's first spring in springComplianceScale_
   for (int f = 0; f < kSpringFamilyCount; ++f) {
-    const float k = stiffnessOf(settings_, f);
-    if (k <= 0.0f) continue;
     const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
+    const std::size_t base = offset;
+    offset += set.size();
+    const float k0 = stiffnessOf(settings_, f);
+    if (k0 <= 0.0f) continue;
     for (std::size_t s = 0; s < set.size(); ++s) {
       const std::uint32_t i = set.first[s], j = set.second[s];
       const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
       const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
       if (len < 1e-9f) continue;
+      const float k = springScale != nullptr ? k0 / springScale[base + s] : k0;
       const float fs = k * (len - set.restLength[s]) / len;  // force on i along d, N/m * m / m
       ax[i] += w[i] * fs * dx;
       ay[i] += w[i] * fs * dy;
@@ -834,22 +915,29 @@ double Cape::energy() const {
   double e = 0.0;
   const Eigen::VectorXf& m = fabric_->masses();
   for (Eigen::Index i = 0; i < state_.positions.rows(); ++i) {
-    const double mi = m[i];
+    const double mi = static_cast<double>(m[i]) * (massScale_.size() > 0 ? massScale_[i] : 1.0f);
     e += 0.5 * mi * static_cast<double>(state_.velocities.row(i).squaredNorm());
     e -= mi * static_cast<double>(settings_.gravity.dot(state_.positions.row(i).transpose()));
   }
+  std::size_t offset = 0;
   for (int f = 0; f < kSpringFamilyCount; ++f) {
-    const double k = stiffnessOf(settings_, f);
-    if (!(k > 0.0) || std::isinf(k)) continue;
     const SpringSet& set = fabric_->springs(static_cast<SpringFamily>(f));
+    const std::size_t base = offset;
+    offset += set.size();
+    const double k0 = stiffnessOf(settings_, f);
+    if (!(k0 > 0.0) || std::isinf(k0)) continue;
     for (std::size_t s = 0; s < set.size(); ++s) {
       const double len = (state_.positions.row(set.first[s]) - state_.positions.row(set.second[s])).norm();
       const double ext = len - set.restLength[s];
+      const double k = springComplianceScale_.size() > 0
+                           ? k0 / springComplianceScale_[static_cast<Eigen::Index>(base + s)]
+                           : k0;
       e += 0.5 * k * ext * ext;
     }
   }
   if (settings_.bendingRigidity > 0.0f)
-    e += detail::hingeEnergy(state_.positions, fabric_->hinges(), settings_.bendingRigidity);
+    e += detail::hingeEnergy(state_.positions, fabric_->hinges(), settings_.bendingRigidity,
+                             hingeStiffnessScale_.size() > 0 ? hingeStiffnessScale_.data() : nullptr);
   return e;
 }
 

@@ -16,8 +16,8 @@ constexpr float kMaxLength2 = std::numeric_limits<float>::max();
 namespace {
 
 // solveSpringsScalar's loop; without multipliers (kLambda false) every lambda is zero and none is stored.
-template <bool kLambda>
-void scalarSprings(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde) {
+template <bool kLambda, bool kScaled>
+void scalarSprings(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaBase) {
   float* __restrict px = a.px;
   float* __restrict py = a.py;
   float* __restrict pz = a.pz;
@@ -33,6 +33,8 @@ void scalarSprings(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_
     // A zero length has no direction, and a length whose square overflows (a runaway particle, restored by
     // the cape's guard after the step) no finite one.
     if (!(len2 > 1e-18f && len2 <= kMaxLength2)) continue;
+    float alphaTilde = alphaBase;
+    if constexpr (kScaled) alphaTilde = alphaBase * a.complianceScale[s];
     const float wsum = wi + wj;
     const float invDenominator = wsum > 0.0f ? 1.0f / (wsum + alphaTilde) : 0.0f;  // 0: both ends pinned
     const float len = std::sqrt(len2);
@@ -58,10 +60,16 @@ void scalarSprings(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_
 
 void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end,
                         float alphaTilde) {
-  if (a.lambda != nullptr)
-    scalarSprings<true>(a, begin, end, alphaTilde);
-  else
-    scalarSprings<false>(a, begin, end, alphaTilde);
+  if (a.complianceScale != nullptr) {
+    if (a.lambda != nullptr)
+      scalarSprings<true, true>(a, begin, end, alphaTilde);
+    else
+      scalarSprings<false, true>(a, begin, end, alphaTilde);
+  } else if (a.lambda != nullptr) {
+    scalarSprings<true, false>(a, begin, end, alphaTilde);
+  } else {
+    scalarSprings<false, false>(a, begin, end, alphaTilde);
+  }
 }
 
 void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers,
@@ -177,16 +185,18 @@ inline __m128 select(__m128 mask, __m128 ifTrue, __m128 ifFalse) {
 
 // solveSpringsScalar's body in four lanes. A lane whose spring has no direction keeps its old values (a
 // select, not a multiplication by zero, so not even the sign of a zero changes).
-template <SpringLayout L, bool kLambda>
+template <SpringLayout L, bool kLambda, bool kScaled>
 void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde) {
   using In = Lanes<L>;
-  const __m128 alpha = _mm_set1_ps(alphaTilde);
+  const __m128 alphaBase = _mm_set1_ps(alphaTilde);
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
   const __m128 minLen2 = _mm_set1_ps(1e-18f);
   const __m128 maxLen2 = _mm_set1_ps(kMaxLength2);
   for (std::uint32_t s = begin; s < end; s += 4) {
     const std::uint32_t* p = a.first + s;
     const std::uint32_t* q = a.second + s;
+    __m128 alpha = alphaBase;
+    if constexpr (kScaled) alpha = _mm_mul_ps(alphaBase, _mm_loadu_ps(a.complianceScale + s));
     __m128 xi, xj, yi, yj, zi, zj, wi, wj;
     In::load(a.px, p, q, xi, xj);
     In::load(a.py, p, q, yi, yj);
@@ -220,23 +230,23 @@ void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t 
   }
 }
 
-template <bool kLambda>
+template <bool kLambda, bool kScaled>
 void solveRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
   switch (run.layout) {
     case SpringLayout::Contiguous:
-      return solveBlocks<SpringLayout::Contiguous, kLambda>(a, run.begin, run.end, alphaTilde);
+      return solveBlocks<SpringLayout::Contiguous, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
     case SpringLayout::PairSwapped:
-      return solveBlocks<SpringLayout::PairSwapped, kLambda>(a, run.begin, run.end, alphaTilde);
+      return solveBlocks<SpringLayout::PairSwapped, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
     case SpringLayout::Interleaved:
-      return solveBlocks<SpringLayout::Interleaved, kLambda>(a, run.begin, run.end, alphaTilde);
+      return solveBlocks<SpringLayout::Interleaved, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
     case SpringLayout::Pairs:
-      return solveBlocks<SpringLayout::Pairs, kLambda>(a, run.begin, run.end, alphaTilde);
+      return solveBlocks<SpringLayout::Pairs, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
     case SpringLayout::Gathered:
-      return solveBlocks<SpringLayout::Gathered, kLambda>(a, run.begin, run.end, alphaTilde);
+      return solveBlocks<SpringLayout::Gathered, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
     case SpringLayout::Scalar:
       break;
   }
-  scalarSprings<kLambda>(a, run.begin, run.end, alphaTilde);
+  scalarSprings<kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
 }
 
 }  // namespace
@@ -277,10 +287,16 @@ void solveTethers(float* px, float* py, float* pz, const float* inverseMass, con
 }
 
 void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
-  if (a.lambda != nullptr)
-    solveRun<true>(a, run, alphaTilde);
-  else
-    solveRun<false>(a, run, alphaTilde);
+  if (a.complianceScale != nullptr) {
+    if (a.lambda != nullptr)
+      solveRun<true, true>(a, run, alphaTilde);
+    else
+      solveRun<false, true>(a, run, alphaTilde);
+  } else if (a.lambda != nullptr) {
+    solveRun<true, false>(a, run, alphaTilde);
+  } else {
+    solveRun<false, false>(a, run, alphaTilde);
+  }
 }
 
 #else
@@ -318,7 +334,7 @@ inline HingeGeometry hingeGeometry(const float* px, const float* py, const float
 }  // namespace
 
 void solveHinges(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
-                 float bendingRigidity, float invH2, float* lambda) {
+                 float bendingRigidity, float invH2, float* lambda, const float* stiffnessScale) {
   for (std::size_t k = 0; k < hinges.size(); ++k) {
     const HingeGeometry g = hingeGeometry(px, py, pz, hinges, k);
     if (!(g.length > 1e-12f) || !std::isfinite(g.length)) continue;
@@ -328,7 +344,8 @@ void solveHinges(float* px, float* py, float* pz, const float* inverseMass, cons
     // A clamp (the middle and one arm pinned): the pinned half of the hinge's area lies on the support, held
     // straight, so the hinge bends over its free half only: twice the stiffness.
     const float clamp = wj == 0.0f && ((wi == 0.0f) != (wl == 0.0f)) ? 2.0f : 1.0f;
-    const float alphaTilde = invH2 / (clamp * bendingRigidity * hinges.areaOverLength2[k]);
+    const float scale = stiffnessScale != nullptr ? stiffnessScale[k] : 1.0f;
+    const float alphaTilde = invH2 / (clamp * scale * bendingRigidity * hinges.areaOverLength2[k]);
     const float denominator = wi * a * a + wl * b * b + wj * ab * ab + alphaTilde;
     if (!(denominator > 0.0f)) continue;
     const float previous = lambda != nullptr ? lambda[k] : 0.0f;
@@ -349,13 +366,15 @@ void solveHinges(float* px, float* py, float* pz, const float* inverseMass, cons
 }
 
 void addHingeForces(const float* px, const float* py, const float* pz, const float* inverseMass,
-                    const HingeSet& hinges, float bendingRigidity, float* ax, float* ay, float* az) {
+                    const HingeSet& hinges, float bendingRigidity, float* ax, float* ay, float* az,
+                    const float* stiffnessScale) {
   for (std::size_t k = 0; k < hinges.size(); ++k) {
     const HingeGeometry g = hingeGeometry(px, py, pz, hinges, k);
     if (!(g.length > 1e-12f) || !std::isfinite(g.length)) continue;
     const std::uint32_t i = hinges.first[k], j = hinges.middle[k], l = hinges.second[k];
     const float a = hinges.firstWeight[k], b = hinges.secondWeight[k], ab = a + b;
-    const float s = -bendingRigidity * hinges.areaOverLength2[k] * g.c / g.length;  // -k C along n
+    const float scale = stiffnessScale != nullptr ? stiffnessScale[k] : 1.0f;
+    const float s = -scale * bendingRigidity * hinges.areaOverLength2[k] * g.c / g.length;  // -k C along n
     const float fx = g.dx * s, fy = g.dy * s, fz = g.dz * s;
     ax[i] += inverseMass[i] * a * fx;
     ay[i] += inverseMass[i] * a * fy;
@@ -369,12 +388,14 @@ void addHingeForces(const float* px, const float* py, const float* pz, const flo
   }
 }
 
-double hingeEnergy(const Points& positions, const HingeSet& hinges, float bendingRigidity) {
+double hingeEnergy(const Points& positions, const HingeSet& hinges, float bendingRigidity,
+                   const float* stiffnessScale) {
   double e = 0.0;
   const float *px = positions.col(0).data(), *py = positions.col(1).data(), *pz = positions.col(2).data();
   for (std::size_t k = 0; k < hinges.size(); ++k) {
     const HingeGeometry g = hingeGeometry(px, py, pz, hinges, k);
-    e += 0.5 * static_cast<double>(bendingRigidity) * hinges.areaOverLength2[k] * g.c * g.c;
+    const double scale = stiffnessScale != nullptr ? stiffnessScale[k] : 1.0;
+    e += 0.5 * scale * static_cast<double>(bendingRigidity) * hinges.areaOverLength2[k] * g.c * g.c;
   }
   return e;
 }

@@ -22,6 +22,9 @@ struct SpringSolveArrays {
   const std::uint32_t* second = nullptr;
   const float* restLength = nullptr;
   float* lambda = nullptr;
+  /// Per spring, a factor on the compliance (the inverse of a stiffness scale, Cape::setStiffnessScale);
+  /// null: 1 for every spring (the kernels then do not read it: the same bits as before scales existed).
+  const float* complianceScale = nullptr;
 };
 
 /// XPBD distance constraints C = |xj - xi| - L with compliance alpha (Macklin et al. 2016):
@@ -58,14 +61,18 @@ void solveTethers(float* px, float* py, float* pz, const float* inverseMass, con
 /// straight line) has no direction and is left alone. `lambda` may be null, as SpringSolveArrays'.
 /// `invH2` is 1 / h^2.
 void solveHinges(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
-                 float bendingRigidity, float invH2, float* lambda);
+                 float bendingRigidity, float invH2, float* lambda, const float* stiffnessScale = nullptr);
 
+/// `stiffnessScale`, when not null, multiplies each hinge's stiffness (Cape::setStiffnessScale).
+///
 /// The hinges' elastic forces for the explicit integrator, -k C grad C with k = bendingRigidity
 /// areaOverLength2, added to the accelerations (times the inverse masses).
 void addHingeForces(const float* px, const float* py, const float* pz, const float* inverseMass,
-                    const HingeSet& hinges, float bendingRigidity, float* ax, float* ay, float* az);
+                    const HingeSet& hinges, float bendingRigidity, float* ax, float* ay, float* az,
+                    const float* stiffnessScale = nullptr);
 
 /// The hinges' elastic energy, J: sum of 1/2 k C^2.
-double hingeEnergy(const Points& positions, const HingeSet& hinges, float bendingRigidity);
+double hingeEnergy(const Points& positions, const HingeSet& hinges, float bendingRigidity,
+                   const float* stiffnessScale = nullptr);
 
 }  // namespace cape::detail

@@ -120,6 +120,20 @@ class CAPE_CORE_API Cape {
   Status setMotionConstraints(const MotionConstraints& constraints);
   /// The motion constraints in use.
   const MotionConstraints& motionConstraints() const { return motion_; }
+  /// A per-particle mass scale (a weight map, as WeightMap.h paints): particle i weighs
+  /// fabric().masses()[i] * scale[i] (a heavier hem, a lighter collar), and its inverse mass is the inverse
+  /// of that while it is free; energy() counts the scaled masses. Empty: the fabric's masses. An error,
+  /// keeping the old scale, for another size than the particles, a value not finite in (0, 1e6], or (the
+  /// explicit integrator) a substep the lighter particles would make unstable.
+  Status setMassScale(const Eigen::VectorXf& scale);
+  /// The mass scale in use (empty: none).
+  const Eigen::VectorXf& massScale() const { return massScale_; }
+  /// A per-particle stiffness scale (a weight map): every spring's stiffness times the mean of its two ends'
+  /// values, every bending hinge's times its middle particle's (tethers, pins and collisions are not
+  /// scaled). Empty: none (the same bits as before it was set). The same errors as setMassScale().
+  Status setStiffnessScale(const Eigen::VectorXf& scale);
+  /// The stiffness scale in use (empty: none).
+  const Eigen::VectorXf& stiffnessScale() const { return stiffnessScale_; }
   /// The animated position of every particle for the next step and those after (frame coordinates, m, one
   /// row per particle): a skinning the caller gives, again whenever it moves. An empty matrix goes back to
   /// the default, the rest shape fitted to the pins at the end of each step. An error on a wrong size or a
@@ -255,6 +269,9 @@ class CAPE_CORE_API Cape {
   void accumulateExternalAcceleration();
   void accumulateSpringForces();
   void solveSprings(float h);
+  /// The explicit integrator's stability with these scales (success for XPBD).
+  Status checkExplicitStability(const Eigen::VectorXf& massScale,
+                                const Eigen::VectorXf& stiffnessScale) const;
   void solveTethers();
   void adaptRefinement();
   /// Whether nothing the cape feels moves in this step (pins and colliders still, no wind).
@@ -270,6 +287,10 @@ class CAPE_CORE_API Cape {
   Pose reference_;                                    ///< The rest shape's pose in the frame.
   std::vector<std::uint8_t> pinnedComponent_;         ///< 1 for each fabric component holding a pin.
   GuardReport guard_;
+  Eigen::VectorXf massScale_;              ///< Per particle (empty: none).
+  Eigen::VectorXf stiffnessScale_;         ///< Per particle (empty: none).
+  Eigen::VectorXf springComplianceScale_;  ///< Per spring, every family in turn: 1 / its stiffness scale.
+  Eigen::VectorXf hingeStiffnessScale_;    ///< Per hinge: its middle particle's stiffness scale.
   MotionConstraints motion_;
   bool motionActive_ = false;  ///< Some array of motion_ is set.
   bool userAnimated_ = false;  ///< animated_ is the caller's (setAnimatedPositions), not the fit.
