@@ -247,15 +247,8 @@ Status Cape::setGravity(const Vec3& gravity) {
 Status Cape::setSettings(const CapeSettings& settings) {
   Status s = settings.validate();
   if (!s.ok()) return s;
-  if (settings.integrator == Integrator::ExplicitSpring) {
-    const float hMax = explicitStableStep(*fabric_, settings, massScale_, stiffnessScale_);
-    const float h = settings.timeStep / static_cast<float>(settings.substeps);
-    if (h >= hMax) {
-      return Status::error("CapeSettings: the explicit integrator is unstable for this fabric: substep " +
-                           std::to_string(h) + " s >= stability bound " + std::to_string(hMax) +
-                           " s; lower the stiffness or raise the substeps");
-    }
-  }
+  if (Status stable = checkExplicitStability(settings, massScale_, stiffnessScale_); !stable.ok())
+    return stable;
   settings_ = settings;
   wake();
   for (int f = 0; f < kSpringFamilyCount; ++f) {
@@ -311,21 +304,22 @@ Status checkScale(const char* what, const Eigen::VectorXf& scale, std::size_t pa
 
 }  // namespace
 
-Status Cape::checkExplicitStability(const Eigen::VectorXf& massScale,
+Status Cape::checkExplicitStability(const CapeSettings& settings, const Eigen::VectorXf& massScale,
                                     const Eigen::VectorXf& stiffnessScale) const {
-  if (settings_.integrator != Integrator::ExplicitSpring) return Status::success();
-  const float hMax = explicitStableStep(*fabric_, settings_, massScale, stiffnessScale);
-  const float h = settings_.timeStep / static_cast<float>(settings_.substeps);
+  if (settings.integrator != Integrator::ExplicitSpring) return Status::success();
+  const float hMax = explicitStableStep(*fabric_, settings, massScale, stiffnessScale);
+  const float h = settings.timeStep / static_cast<float>(settings.substeps);
   if (h >= hMax)
-    return Status::error("Cape: the explicit integrator would be unstable with this scale: substep " +
-                         std::to_string(h) + " s >= stability bound " + std::to_string(hMax) + " s");
+    return Status::error("CapeSettings: the explicit integrator is unstable for this fabric: substep " +
+                         std::to_string(h) + " s >= stability bound " + std::to_string(hMax) +
+                         " s; lower the stiffness (or its scale), raise the masses or the substeps");
   return Status::success();
 }
 
 Status Cape::setMassScale(const Eigen::VectorXf& scale) {
   if (!ok()) return status_;
   if (Status s = checkScale("setMassScale", scale, fabric_->particleCount()); !s.ok()) return s;
-  if (Status s = checkExplicitStability(scale, stiffnessScale_); !s.ok()) return s;
+  if (Status s = checkExplicitStability(settings_, scale, stiffnessScale_); !s.ok()) return s;
   wake();
   massScale_ = scale;
   const Eigen::VectorXf& m = fabric_->masses();
@@ -338,7 +332,7 @@ Status Cape::setMassScale(const Eigen::VectorXf& scale) {
 Status Cape::setStiffnessScale(const Eigen::VectorXf& scale) {
   if (!ok()) return status_;
   if (Status s = checkScale("setStiffnessScale", scale, fabric_->particleCount()); !s.ok()) return s;
-  if (Status s = checkExplicitStability(massScale_, scale); !s.ok()) return s;
+  if (Status s = checkExplicitStability(settings_, massScale_, scale); !s.ok()) return s;
   wake();
   stiffnessScale_ = scale;
   springComplianceScale_.resize(0);

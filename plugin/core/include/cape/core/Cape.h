@@ -269,8 +269,8 @@ class CAPE_CORE_API Cape {
   void accumulateExternalAcceleration();
   void accumulateSpringForces();
   void solveSprings(float h);
-  /// The explicit integrator's stability with these scales (success for XPBD).
-  Status checkExplicitStability(const Eigen::VectorXf& massScale,
+  /// The explicit integrator's stability with these settings and scales (success for XPBD).
+  Status checkExplicitStability(const CapeSettings& settings, const Eigen::VectorXf& massScale,
                                 const Eigen::VectorXf& stiffnessScale) const;
   void solveTethers();
   void adaptRefinement();
