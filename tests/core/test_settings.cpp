@@ -189,5 +189,38 @@ TEST(Settings, UnpinRestoresTheMass) {
   EXPECT_TRUE(cape.state().pins.empty());
 }
 
+TEST(Settings, ASubstepOverrideStepsAsTheSettingsSubstepsWouldAndIsRefusedOutOfRange) {
+  // A level of detail's substeps (Cape::setSubstepOverride): 2 per 1/60 s in place of the settings' 3 gives
+  // the bits of settings with 2, and 0 gives the settings' own back, from the state as it is.
+  FabricPtr f = makeGrid(8, 8, 0.6f, 1.0f, 0.4f, true, {0, 7});
+  CapeSettings two;
+  two.substeps = 2;
+  Cape lod(f, CapeSettings()), ref(f, two), full(f, CapeSettings());
+  for (Cape* c : {&lod, &ref, &full}) {
+    c->pin(0, test::row(f->restPositions(), 0));
+    c->pin(7, test::row(f->restPositions(), 7));
+  }
+  ASSERT_TRUE(lod.setSubstepOverride(2).ok());
+  EXPECT_EQ(lod.substepOverride(), 2);
+  for (int k = 0; k < 30; ++k) {
+    lod.step(1.0f / 60.0f, {});
+    ref.step(1.0f / 60.0f, {});
+  }
+  EXPECT_EQ(stateHash(lod.state()), stateHash(ref.state()));
+  ASSERT_TRUE(lod.setSubstepOverride(0).ok());
+  full.mutableState() = lod.state();
+  for (int k = 0; k < 30; ++k) {
+    lod.step(1.0f / 60.0f, {});
+    full.step(1.0f / 60.0f, {});
+  }
+  EXPECT_EQ(stateHash(lod.state()), stateHash(full.state()));
+  for (int bad : {-1, 1001}) {
+    const Status s = lod.setSubstepOverride(bad);
+    EXPECT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("setSubstepOverride"), std::string::npos) << s.message();
+    EXPECT_EQ(lod.substepOverride(), 0);
+  }
+}
+
 }  // namespace
 }  // namespace cape

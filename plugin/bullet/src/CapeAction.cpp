@@ -411,7 +411,7 @@ void CapeAction::discover(btCollisionWorld* world) {
   // The cape's bounds at the start of the step, grown by its thickness and the discovery margin, in the
   // world (the frame's origin added in double).
   const Points& x = cape_.state().positions;
-  const btScalar grow = btScalar(cape_.settings().collisionThickness) + settings_.discoveryMargin;
+  const btScalar grow = btScalar(cape_.settings().collisionThickness) + discoveryReach();
   const Eigen::Vector3d& o = cape_.origin();
   const Eigen::Vector3d lo = x.colwise().minCoeff().transpose().cast<double>() + o;
   const Eigen::Vector3d hi = x.colwise().maxCoeff().transpose().cast<double>() + o;
@@ -675,8 +675,7 @@ void CapeAction::gatherTriangles(const btConcaveShape* shape, const btTransform&
   collect.soup = &soup;
   soup.corners.clear();  // keeps its capacity: no allocation once the cape has met the mesh
   const Points& x = cape_.state().positions;  // the poses are in the cape's frame too
-  const btScalar grow =
-      btScalar(cape_.settings().collisionThickness) + shape->getMargin() + settings_.discoveryMargin;
+  const btScalar grow = btScalar(cape_.settings().collisionThickness) + shape->getMargin() + discoveryReach();
   const btVector3 lo = toBt(Vec3(x.colwise().minCoeff().transpose())) - btVector3(grow, grow, grow);
   const btVector3 hi = toBt(Vec3(x.colwise().maxCoeff().transpose())) + btVector3(grow, grow, grow);
   btVector3 qlo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), qhi = -qlo;
@@ -700,8 +699,50 @@ void CapeAction::followGravity(btCollisionWorld* world) {
     warnOnce("gravity", "the world's gravity is not finite; the cape keeps its own");
 }
 
+Status DetailLevel::validate() const {
+  if (stepInterval < 1 || stepInterval > kMaxStepInterval)
+    return Status::error("DetailLevel: stepInterval must be in 1.." + std::to_string(kMaxStepInterval) +
+                         ", not " + std::to_string(stepInterval));
+  if (substeps < 0 || substeps > 1000)
+    return Status::error("DetailLevel: substeps must be 0 (the settings' own) or in 1..1000, not " +
+                         std::to_string(substeps));
+  return Status::success();
+}
+
+Status CapeAction::setDetailLevel(const DetailLevel& level) {
+  if (Status s = level.validate(); !s.ok()) return s;
+  if (!ok()) return Status::error("CapeAction::setDetailLevel: the cape was not made");
+  if (Status s = cape_.setSubstepOverride(level.substeps); !s.ok()) return s;
+  detail_ = level;
+  return Status::success();
+}
+
+btVector3 CapeAction::detailPoint() const {
+  if (!ok()) return btVector3(0, 0, 0);
+  const CapeState& st = cape_.state();
+  Vec3 sum = Vec3::Zero();
+  for (const Pin& p : st.pins) sum += p.target;
+  const Vec3 at = st.pins.empty() ? Vec3(st.positions.row(0).transpose())
+                                  : Vec3(sum / static_cast<float>(st.pins.size()));
+  return toWorld(at);
+}
+
+btScalar CapeAction::discoveryReach() const {
+  // The margin covers a step's motion of the bodies around; a step over several internal steps is longer.
+  return settings_.discoveryMargin * btScalar(detail_.stepInterval);
+}
+
 void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
+  due_ = false;
   if (!ok() || world == nullptr || !(dt > 0)) return;
+  // At a coarser level of detail the internal steps between the cape's own steps only add up their time.
+  skippedTime_ += dt;
+  if (++skippedSteps_ < detail_.stepInterval) return;
+  dt = skippedTime_;  // exactly dt at full detail (0 + dt)
+  skippedTime_ = 0;
+  skippedSteps_ = 0;
+  stepTime_ = dt;
+  due_ = true;
   const auto start = std::chrono::steady_clock::now();
   if (settings_.useWorldGravity) followGravity(world);
   reportGuard();
@@ -725,10 +766,11 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
 }
 
-void CapeAction::advance(btScalar dt) {
-  if (!ok() || !(dt > 0)) return;
+void CapeAction::advance(btScalar) {
+  if (!ok() || !due_) return;
+  due_ = false;
   const auto start = std::chrono::steady_clock::now();
-  cape_.step(static_cast<float>(dt), ColliderSpan(colliders_));
+  cape_.step(static_cast<float>(stepTime_), ColliderSpan(colliders_));
   ++stepCount_;
   lastStepMicroseconds_ =
       prepareMicroseconds_ +

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <string>
 
 namespace cape::bullet {
 
@@ -20,12 +22,17 @@ CapeGroup::~CapeGroup() {
 }
 
 void CapeGroup::add(CapeAction* cape) {
-  if (cape != nullptr && std::find(capes_.begin(), capes_.end(), cape) == capes_.end())
+  if (cape != nullptr && std::find(capes_.begin(), capes_.end(), cape) == capes_.end()) {
     capes_.push_back(cape);
+    if (!band_.empty()) band_.push_back(-1);  // its band is chosen at the next step
+  }
 }
 
 void CapeGroup::remove(CapeAction* cape) {
-  capes_.erase(std::remove(capes_.begin(), capes_.end(), cape), capes_.end());
+  const auto it = std::find(capes_.begin(), capes_.end(), cape);
+  if (it == capes_.end()) return;
+  if (!band_.empty()) band_.erase(band_.begin() + (it - capes_.begin()));
+  capes_.erase(it);
 }
 
 void CapeGroup::work(int worker) {
@@ -51,7 +58,63 @@ void CapeGroup::runWorker(int worker) {
   }
 }
 
+Status CapeGroup::setDetailPolicy(const btVector3& viewpoint, std::vector<DetailBand> bands,
+                                  btScalar hysteresis) {
+  const auto finite = [](const btVector3& v) {
+    return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+  };
+  if (!finite(viewpoint)) return Status::error("CapeGroup::setDetailPolicy: the viewpoint is not finite");
+  if (!std::isfinite(hysteresis) || hysteresis < 0)
+    return Status::error("CapeGroup::setDetailPolicy: hysteresis must be finite and >= 0 m");
+  for (std::size_t k = 0; k < bands.size(); ++k) {
+    const btScalar d = bands[k].distance;
+    if (!std::isfinite(d) || d < 0 || (k > 0 && !(d > bands[k - 1].distance)))
+      return Status::error("CapeGroup::setDetailPolicy: band " + std::to_string(k) +
+                           "'s distance must be finite, >= 0 m and beyond the band before it");
+    if (Status s = bands[k].level.validate(); !s.ok())
+      return Status::error("CapeGroup::setDetailPolicy: band " + std::to_string(k) + ": " + s.message());
+  }
+  const bool had = !bands_.empty();
+  viewpoint_ = viewpoint;
+  bands_ = std::move(bands);
+  hysteresis_ = hysteresis;
+  band_.clear();  // every cape's band is chosen afresh at the next step
+  bandCounts_.clear();
+  if (bands_.empty() && had)
+    for (CapeAction* cape : capes_) cape->setDetailLevel(DetailLevel());
+  return Status::success();
+}
+
+void CapeGroup::setViewpoint(const btVector3& viewpoint) {
+  if (std::isfinite(viewpoint.x()) && std::isfinite(viewpoint.y()) && std::isfinite(viewpoint.z()))
+    viewpoint_ = viewpoint;
+}
+
+void CapeGroup::applyDetailPolicy() {
+  const int n = static_cast<int>(bands_.size());
+  band_.resize(capes_.size(), -1);
+  bandCounts_.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (std::size_t i = 0; i < capes_.size(); ++i) {
+    const btScalar d = (capes_[i]->detailPoint() - viewpoint_).length();
+    int b = band_[i];
+    if (b < 0) {
+      b = 0;  // no band yet: the plain rule, no hysteresis
+      while (b < n && d > bands_[static_cast<std::size_t>(b)].distance) ++b;
+    } else {
+      while (b < n && d > bands_[static_cast<std::size_t>(b)].distance + hysteresis_) ++b;
+      while (b > 0 && d < bands_[static_cast<std::size_t>(b - 1)].distance - hysteresis_) --b;
+    }
+    if (b != band_[i]) {
+      // Validated with the policy; a cape that was not made refuses, and stays as it is.
+      capes_[i]->setDetailLevel(b == 0 ? DetailLevel() : bands_[static_cast<std::size_t>(b - 1)].level);
+      band_[i] = b;
+    }
+    ++bandCounts_[static_cast<std::size_t>(b)];
+  }
+}
+
 void CapeGroup::updateAction(btCollisionWorld* world, btScalar dt) {
+  if (!bands_.empty()) applyDetailPolicy();
   // Reading the world (bodies, discovery) stays on this thread.
   for (CapeAction* cape : capes_) cape->prepare(world, dt);
   const auto start = std::chrono::steady_clock::now();

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 namespace cape {
 
@@ -255,6 +256,14 @@ Status Cape::setSettings(const CapeSettings& settings) {
     const float k = stiffnessOf(settings_, f);
     familyCompliance_[static_cast<std::size_t>(f)] = k > 0.0f ? 1.0f / k : kInf;  // inf compliance = off
   }
+  return Status::success();
+}
+
+Status Cape::setSubstepOverride(int substeps) {
+  if (substeps < 0 || substeps > 1000)
+    return Status::error("Cape::setSubstepOverride: substeps must be 0 (none) or in 1..1000, not " +
+                         std::to_string(substeps));
+  substepOverride_ = substeps;
   return Status::success();
 }
 
@@ -512,7 +521,8 @@ Cape::StepPlan Cape::planSubsteps(float dt) const {
   // Counts are bounded before they become ints (dt <= kMaxStep, timeStep >= 1e-5 s: at most 1e8 substeps
   // before refinement; the cap keeps a pathological explicit bound from overflowing).
   constexpr double kMaxSubsteps = 1e6;
-  const float targetSubstep = settings_.timeStep / static_cast<float>(settings_.substeps);
+  const int perTimeStep = substepOverride_ > 0 ? substepOverride_ : settings_.substeps;
+  const float targetSubstep = settings_.timeStep / static_cast<float>(perTimeStep);
   int substeps = static_cast<int>(
       std::clamp(std::ceil(static_cast<double>(dt / targetSubstep - 1e-3f)), 1.0, kMaxSubsteps));
   if (settings_.integrator == Integrator::Xpbd) substeps *= refinement_;

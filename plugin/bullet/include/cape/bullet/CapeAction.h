@@ -110,6 +110,30 @@ struct CapeActionSettings {
   btScalar frameSpacing = btScalar(16);
 };
 
+/// A level of detail: how often and how finely a cape steps (CapeAction::setDetailLevel, or by distance
+/// from a viewpoint with CapeGroup::setDetailPolicy). The cape's state is carried across a switch as it is
+/// (the same particles, pins and velocities), so no particle jumps when the level changes.
+struct DetailLevel {
+  /// The cape steps once every this many internal steps of the world (1..kMaxStepInterval), over their
+  /// time together: the pins and colliders are swept over the longer step, discovery looks as many times
+  /// farther (CapeActionSettings::discoveryMargin times the interval), and the steps between cost nothing.
+  /// 4 steps a cape in a 1/240 s world once per 1/60 s frame. 1: every internal step (full detail).
+  int stepInterval = 1;
+  /// Substeps per CapeSettings::timeStep at this level (Cape::setSubstepOverride); 0: the settings' own.
+  int substeps = 0;
+
+  /// The largest stepInterval.
+  static constexpr int kMaxStepInterval = 64;
+  /// An error naming the field for an interval outside 1..kMaxStepInterval or substeps outside 0..1000.
+  Status validate() const;
+  /// Full detail: every internal step, the settings' substeps.
+  bool full() const { return stepInterval == 1 && substeps == 0; }
+  bool operator==(const DetailLevel& o) const {
+    return stepInterval == o.stepInterval && substeps == o.substeps;
+  }
+  bool operator!=(const DetailLevel& o) const { return !(*this == o); }
+};
+
 /// One particle pinned to a rigid body at a point in the body's frame.
 struct Attachment {
   std::uint32_t particle = 0;         ///< The pinned particle's index.
@@ -147,6 +171,19 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
     settings_ = settings;
     changed_ = true;
   }
+  /// Level of detail from the next internal step on (DetailLevel): an error for an interval outside
+  /// 1..DetailLevel::kMaxStepInterval or substeps outside 0..1000, keeping the level in use. Internal steps
+  /// already skipped at the old level count towards the new one's interval (a switch to full detail steps
+  /// the cape at once, over the time it skipped).
+  Status setDetailLevel(const DetailLevel& level);
+  /// The level of detail in use.
+  const DetailLevel& detailLevel() const { return detail_; }
+  /// The point a level-of-detail policy measures its distance to (CapeGroup::setDetailPolicy), m, world:
+  /// the mean of the pins' targets, or particle 0 when nothing is pinned.
+  btVector3 detailPoint() const;
+  /// True when prepare() planned a step of the cape that advance() has not taken yet (false after an
+  /// internal step skipped at a level of detail, or when nothing can step).
+  bool stepDue() const { return due_; }
   /// Where warnings go (stderr by default; an empty handler drops them).
   void setWarningHandler(WarningHandler handler) { warn_ = std::move(handler); }
 
@@ -209,7 +246,9 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   /// their poses, collider discovery) and must run on one thread; advance() touches only this cape and
   /// the shapes' read-only data, so several capes may advance at once on different threads.
   void prepare(btCollisionWorld* world, btScalar dt);
-  /// The second half of updateAction (dt s): steps the core cape against the colliders prepare() built.
+  /// The second half of updateAction: steps the core cape against the colliders prepare() built, over the
+  /// time prepare() planned (dt s at full detail; the skipped internal steps' time too at a coarser level);
+  /// nothing when prepare() planned no step (stepDue()). `dt` is that of the internal step.
   void advance(btScalar dt);
 
   // --- Results -----------------------------------------------------------------------------------------
@@ -259,7 +298,7 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   btScalar maxPinError() const;
   /// True when the last step teleported the cape.
   bool teleportedLastStep() const { return teleported_; }
-  /// Internal steps taken so far.
+  /// Steps the cape took so far (one per internal step at full detail; see DetailLevel).
   std::uint64_t stepCount() const { return stepCount_; }
 
  private:
@@ -311,6 +350,8 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   void reportGuard();
   void warnOnce(const std::string& key, const std::string& message);
   const btRigidBody* referenceBody() const;
+  /// How far beyond the cape's bounds discovery and mesh queries look for one step of the cape, m.
+  btScalar discoveryReach() const;
 
   Cape cape_;
   CapeActionSettings settings_;
@@ -335,6 +376,12 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
 
   /// The rendered pose of a followed body (renderPositions()) in the cape's frame, if it is in `world`.
   bool renderedPose(const btCollisionWorld& world, const btRigidBody* body, btTransform& framePose) const;
+
+  DetailLevel detail_;
+  int skippedSteps_ = 0;      ///< Internal steps since the cape last stepped (at a coarser level).
+  btScalar skippedTime_ = 0;  ///< Their time, s.
+  bool due_ = false;          ///< prepare() planned a step of stepTime_ s.
+  btScalar stepTime_ = 0;
 
   bool teleported_ = false;
   mutable Points worldPositions_;   ///< positions() when the frame is away from the world's origin.

@@ -16,6 +16,13 @@
 
 namespace cape::bullet {
 
+/// One band of a level-of-detail policy (CapeGroup::setDetailPolicy): capes farther than `distance` from
+/// the viewpoint step at `level`.
+struct DetailBand {
+  btScalar distance = 0;  ///< m from the viewpoint.
+  DetailLevel level;
+};
+
 /// Several capes stepped with one Bullet world on a persistent thread pool, bitwise identical results on any
 /// thread count (see CapeGroup.h). Add the group to the world instead of its capes.
 class CAPE_BULLET_API CapeGroup : public btActionInterface {
@@ -40,12 +47,32 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   void updateAction(btCollisionWorld* world, btScalar dt) override;
   /// Draws every member cape (CapeAction::debugDraw).
   void debugDraw(btIDebugDraw* drawer) override;
+  // --- Level of detail ---------------------------------------------------------------------------------
+  /// Levels of detail by distance from a viewpoint (a camera; m, world). Before every internal step each
+  /// member cape's distance (CapeAction::detailPoint) picks its band: the farthest band it is beyond, full
+  /// detail nearer than all. With a hysteresis of `hysteresis` m: a cape moves out to a farther band only
+  /// once beyond its distance + hysteresis, and back in only once nearer than its distance - hysteresis,
+  /// so a cape at an edge does not switch back and forth. An error, keeping the policy in use, for bands
+  /// not in strictly increasing distance, a distance, viewpoint or hysteresis not finite or negative, or a
+  /// level DetailLevel::validate refuses. No bands: the group sets every cape back to full detail once and
+  /// then leaves their levels alone.
+  Status setDetailPolicy(const btVector3& viewpoint, std::vector<DetailBand> bands,
+                         btScalar hysteresis = btScalar(0.5));
+  /// Moves the viewpoint (a camera moving every frame); ignored unless finite.
+  void setViewpoint(const btVector3& viewpoint);
+  /// The bands of the policy in use (empty: none).
+  const std::vector<DetailBand>& detailBands() const { return bands_; }
+  /// How many member capes were in each band at the last internal step: [0] full detail, [k] bands[k - 1]
+  /// (empty without a policy).
+  const std::vector<std::size_t>& detailCounts() const { return bandCounts_; }
+
   /// Wall time of the last parallel advance of all capes, microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
 
  private:
   void work(int worker);
   void runWorker(int worker);
+  void applyDetailPolicy();
 
   std::vector<CapeAction*> capes_;
   int threadCount_ = 1;
@@ -57,6 +84,11 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   int pending_ = 0;               ///< Workers (threads) still busy with the current step.
   bool stopping_ = false;
   btScalar dt_ = 0;
+  btVector3 viewpoint_{0, 0, 0};
+  std::vector<DetailBand> bands_;
+  btScalar hysteresis_ = 0;
+  std::vector<std::size_t> bandCounts_;
+  std::vector<int> band_;  ///< Each member's band, as capes_ (0: full detail; -1: not chosen yet).
   double lastStepMicroseconds_ = 0.0;
 };
 

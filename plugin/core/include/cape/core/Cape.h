@@ -91,6 +91,14 @@ class CAPE_CORE_API Cape {
   const CapeSettings& settings() const { return settings_; }
   /// Changes the settings; rejected (returning the error, keeping the old settings) if invalid.
   Status setSettings(const CapeSettings& settings);
+  /// Level of detail: substeps per settings().timeStep for the next steps in place of settings().substeps
+  /// (1..1000; 0: the settings' own), e.g. fewer for a cape far from the camera. The state stays as it
+  /// is, so a switch either way moves no particle. The strain refinement still multiplies the substeps, and
+  /// the explicit integrator still takes as many as its stability bound needs. An error for a count out of
+  /// range, keeping the one in use.
+  Status setSubstepOverride(int substeps);
+  /// The substep override in use (0: none, settings().substeps apply).
+  int substepOverride() const { return substepOverride_; }
   /// Gravity for the next steps (m/s^2, world frame), e.g. the world's, read before every step. Not finite:
   /// an error, and the gravity stays what it was.
   Status setGravity(const Vec3& gravity);
@@ -281,8 +289,9 @@ class CAPE_CORE_API Cape {
   FabricPtr fabric_;
   CapeSettings settings_;
   std::array<float, kSpringFamilyCount> familyCompliance_{};  ///< 1 / stiffness per family, m/N (inf: off).
-  int refinement_ = 1;                                ///< Substep multiplier of the next step (1, 2, 4, ...).
-  float lastMaxStrain_ = 0.0f;                        ///< Max structural strain after the last step.
+  int substepOverride_ = 0;     ///< Substeps per timeStep in place of the settings' (0: none).
+  int refinement_ = 1;          ///< Substep multiplier of the next step (1, 2, 4, ...).
+  float lastMaxStrain_ = 0.0f;  ///< Max structural strain after the last step.
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  ///< World position of the cape's frame, m.
   Pose reference_;                                    ///< The rest shape's pose in the frame.
   std::vector<std::uint8_t> pinnedComponent_;         ///< 1 for each fabric component holding a pin.
