@@ -79,6 +79,33 @@ class BulletCapeRun final : public SceneRun {
     return true;
   }
 
+  /// Levels of detail by distance (RunOptions::lodDistances) from the viewpoint (scene frame, relative to
+  /// the scene's origin; by default 4 m behind the last row, 1.6 m up).
+  Status setDetail(const std::vector<double>& distances, const std::optional<Eigen::Vector3d>& viewpoint) {
+    if (distances.empty()) return Status::success();
+    Eigen::Vector3d v = viewpoint.value_or(Eigen::Vector3d::Zero());
+    if (!viewpoint) {
+      // Behind the rows (the characters walk towards -Z), at the middle of them, at eye height.
+      const Eigen::Matrix3d toScene = scene_->sceneToWorld().cast<double>().transpose();
+      double minX = 1e300, maxX = -1e300, maxZ = -1e300;
+      for (int k = 0; k < scene_->characterCount(); ++k) {
+        const Eigen::Vector3d p = toScene * scene_->capePlacement(k).position.cast<double>();
+        minX = std::min(minX, p.x()), maxX = std::max(maxX, p.x()), maxZ = std::max(maxZ, p.z());
+      }
+      v = Eigen::Vector3d(0.5 * (minX + maxX), 1.6, maxZ + 4.0);
+    }
+    viewpoint_ = scene_->sceneToWorld().cast<double>() * v + scene_->origin();
+    const bullet::DetailLevel ladder[] = {{2, 0}, {4, 0}, {4, 2}};
+    std::vector<bullet::DetailBand> bands;
+    for (std::size_t k = 0; k < distances.size() && k < 3; ++k)
+      bands.push_back({btScalar(distances[k]), ladder[k]});
+    return group_->setDetailPolicy(
+        btVector3(btScalar(viewpoint_.x()), btScalar(viewpoint_.y()), btScalar(viewpoint_.z())),
+        std::move(bands));
+  }
+  std::vector<std::size_t> detailCounts() const override { return group_->detailCounts(); }
+  Eigen::Vector3d detailViewpoint() const override { return viewpoint_; }
+
   /// The same motion constraints on every character's cape (one fabric: one weight map fits them all).
   Status setMotionConstraints(const MotionConstraints& constraints) {
     for (auto& c : capes_) {
@@ -134,6 +161,7 @@ class BulletCapeRun final : public SceneRun {
   std::vector<std::uint32_t> guardLastFrame_;  ///< what the guard restored in the last frame
   int frame_ = 0;
   double frameUs_ = 0.0, capeUs_ = 0.0;
+  Eigen::Vector3d viewpoint_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace
@@ -146,6 +174,10 @@ std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& e
   for (const std::string& n : scene->notes()) std::printf("cape_walk: %s\n", n.c_str());
   auto run = std::make_unique<BulletCapeRun>(std::move(scene), options.threads);
   if (!run->build(run->settings(), options.scene, error)) return nullptr;
+  if (Status s = run->setDetail(options.lodDistances, options.viewpoint); !s.ok()) {
+    error = "--lod: " + s.message();
+    return nullptr;
+  }
   if (!options.maxDistanceMap.empty()) {
     GrayImage image;
     if (!readGrayPng(options.maxDistanceMap, image, error)) return nullptr;

@@ -60,6 +60,15 @@ struct RunOptions {
   /// maxDistanceRange[0] and white maxDistanceRange[1], m. Empty: no motion constraints.
   std::string maxDistanceMap;
   std::array<float, 2> maxDistanceRange{0.0f, 0.1f};  ///< m, black and white of maxDistanceMap
+  /// Levels of detail by distance from `viewpoint` (--lod, 1 to 3 increasing distances, m): beyond the first
+  /// a cape steps every second internal step, beyond the second once a frame, beyond the third once a frame
+  /// with 2 substeps per 1/60 s (cape::bullet::CapeGroup::setDetailPolicy, 0.5 m hysteresis). Empty: full
+  /// detail for every cape.
+  std::vector<double> lodDistances;
+  /// Where the levels of detail are measured from, m, in the scene's frame (Y up, the characters walking
+  /// towards -Z) relative to `origin` (--viewpoint). Empty: 4 m behind the last row of characters at the
+  /// middle of the rows, 1.6 m up.
+  std::optional<Eigen::Vector3d> viewpoint;
 };
 
 /// The most particles along a side of the cape (--size and the rows that --width and --height make).
@@ -104,6 +113,11 @@ class SceneRun {
   /// The capes' settings as given to them, before the scene's own (settingsForScene): the options'
   /// settings with the fabric preset applied, if any.
   virtual const CapeSettings& settings() const = 0;
+  /// Capes per level of detail at the last step ([0] full detail, then one per --lod distance); empty
+  /// without --lod.
+  virtual std::vector<std::size_t> detailCounts() const { return {}; }
+  /// Where the levels of detail were measured from, m, world (meaningful with --lod).
+  virtual Eigen::Vector3d detailViewpoint() const { return Eigen::Vector3d::Zero(); }
 };
 
 /// The run the options ask for: the shipped humanoid, a URDF character or the simple body, in a Bullet

@@ -97,6 +97,23 @@ int main(int argc, char** argv) {
                "keep the cape from passing through itself (default: on for --cape cape, off for canonical)");
   app.add_flag("--no-self-collision", noSelfCollision, "let the cape pass through itself")
       ->excludes("--self-collision");
+  std::vector<double> lodDistances;
+  std::string viewpoint;
+  CLI::Option* lodOption =
+      app.add_option(
+             "--lod", lodDistances,
+             "levels of detail by distance from --viewpoint, m: D1[,D2[,D3]], increasing. Beyond D1 "
+             "a cape steps every second internal step, beyond D2 once a frame, beyond D3 once a frame "
+             "with 2 substeps (CapeGroup::setDetailPolicy, 0.5 m hysteresis; default: full detail)")
+          ->delimiter(',')
+          ->expected(1, 3)
+          ->transform(strictReal(0.0, 1e6));
+  app.add_option(
+         "--viewpoint", viewpoint,
+         "where --lod measures from (a camera), m, scene frame relative to --origin: X,Y,Z (default: 4 "
+         "m behind the last row of characters, at the middle of the rows, 1.6 m up)")
+      ->check(strictVector3(kMaxOrigin))
+      ->needs(lodOption);
   app.add_option("--threads", threads, "worker threads stepping the capes")
       ->transform(strictInteger(1, 256))
       ->capture_default_str();
@@ -134,6 +151,19 @@ int main(int argc, char** argv) {
     return 1;
   }
   o.threads = threads;
+  for (std::size_t k = 1; k < lodDistances.size(); ++k) {
+    if (!(lodDistances[k] > lodDistances[k - 1])) {
+      std::fprintf(stderr, "cape_walk: --lod: the distances must increase (%g is not beyond %g)\n",
+                   lodDistances[k], lodDistances[k - 1]);
+      return 1;
+    }
+  }
+  o.lodDistances = lodDistances;
+  if (!viewpoint.empty()) {
+    Eigen::Vector3d v;
+    parseVector3(viewpoint, kMaxOrigin, v);  // checked above
+    o.viewpoint = v;
+  }
   o.maxDistanceMap = maxDistanceMap;
   o.maxDistanceRange = {static_cast<float>(maxDistanceRange[0]), static_cast<float>(maxDistanceRange[1])};
   if (!gltf.empty() && o.characters > kMaxGltfCharacters) {
@@ -397,6 +427,12 @@ int main(int argc, char** argv) {
   summary["up"] = o.up == character::UpAxis::Z ? "z" : "y";
   summary["scene_build_s"] = buildSeconds;
   summary["bullet_objects"] = run->worldObjectCount();
+  if (!o.lodDistances.empty()) {
+    const Eigen::Vector3d v = run->detailViewpoint();
+    summary["detail"] = {{"distances_m", o.lodDistances},
+                         {"viewpoint_m", {v.x(), v.y(), v.z()}},
+                         {"capes_per_level_last_frame", run->detailCounts()}};
+  }
   // Each cape's final state (stateHash: the bits of its positions and velocities), for determinism checks.
   for (int k = 0; k < run->characterCount(); ++k) {
     char hex[32];

@@ -575,6 +575,21 @@ void World::setWeightScale(int cape, bool mass, const Eigen::VectorXf& scale) {
   if (!s.ok()) fail(s.message());
 }
 
+void World::setDetailLevel(int cape, int stepInterval, int substeps) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  checkCape(cape);
+  const cape::Status s =
+      capes_[static_cast<std::size_t>(cape)]->action->setDetailLevel({stepInterval, substeps});
+  if (!s.ok()) fail(s.message());
+}
+
+std::pair<int, int> World::detailLevel(int cape) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  checkCape(cape);
+  const cape::bullet::DetailLevel& d = capes_[static_cast<std::size_t>(cape)]->action->detailLevel();
+  return {d.stepInterval, d.substeps};
+}
+
 cape::Points World::capeAnimatedPositions(int cape) const {
   std::lock_guard<std::mutex> lock(mutex_);
   checkCape(cape);

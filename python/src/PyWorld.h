@@ -138,6 +138,10 @@ class World {
   /// Cape::setMotionConstraints; a ValueError with the library's message on bad arrays.
   /// Cape::setMassScale (mass true) or setStiffnessScale: ValueError on bad values, the old scale kept.
   void setWeightScale(int cape, bool mass, const Eigen::VectorXf& scale);
+  /// CapeAction::setDetailLevel: ValueError on a bad level, the old one kept.
+  void setDetailLevel(int cape, int stepInterval, int substeps);
+  /// The cape's level of detail: (step interval, substeps).
+  std::pair<int, int> detailLevel(int cape) const;
   void setMotionConstraints(int cape, const cape::MotionConstraints& constraints);
   /// Each particle's animated position of the last step (Cape::animatedPositions), m, world.
   cape::Points capeAnimatedPositions(int cape) const;

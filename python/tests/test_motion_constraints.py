@@ -1,4 +1,4 @@
-"""Motion constraints from Python: a max distance painted from the UVs holds the cape to its animated pose."""
+"""Motion constraints, weight maps and levels of detail, from Python."""
 import numpy as np
 import pytest
 
@@ -81,3 +81,29 @@ def test_mass_and_stiffness_weight_maps_reach_the_cape():
         plain.set_stiffness_scale(np.ones((2, 2)))
     plain.set_mass_scale(None)
     plain.set_stiffness_scale(None)
+
+
+def test_a_level_of_detail_steps_the_cape_less_often_and_bad_levels_raise():
+    def hang(level=None):
+        world = capecloth.World()
+        left = world.add_sphere(0.08, pose=[-0.22, 1.52, 0, 0, 0, 0, 1])
+        right = world.add_sphere(0.08, pose=[0.22, 1.52, 0, 0, 0, 0, 1])
+        cape = world.add_cape([left, right])
+        if level is not None:
+            cape.set_detail_level(*level)
+        for _ in range(60):
+            world.step()
+        return cape
+
+    full = hang()
+    assert full.detail_level == (1, 0)
+    assert np.array_equal(full.positions, hang((1, 0)).positions)  # full detail changes no bit
+    coarse = hang((4, 2))
+    assert coarse.detail_level == (4, 2)
+    assert np.isfinite(coarse.positions).all()
+    gap = np.linalg.norm(coarse.positions - full.positions, axis=1).max()
+    assert 0 < gap < 0.05  # another solve of the same hang, a few cm at most from it
+    for bad in [(0, 0), (65, 0), (1, -1)]:
+        with pytest.raises(ValueError, match="DetailLevel"):
+            coarse.set_detail_level(*bad)
+    assert coarse.detail_level == (4, 2)

@@ -167,5 +167,50 @@ TEST(Crowd, GltfOfALargeCrowdIsRefusedBeforeAnyWork) {
   EXPECT_FALSE(fs::exists(dir / "run.glb"));
 }
 
+TEST(Crowd, LevelsOfDetailByDistanceFromTheViewpoint) {
+  // 16 simple bodies on a 4 x 4 grid 2 m apart, --lod by distance from a viewpoint: every cape is in one of
+  // the levels, nearer ones at full detail; a viewpoint far away puts every cape in the last level, and
+  // levels that nothing reaches change no bit of any cape.
+  const std::string crowd = kWalk + " --simple-body --scene crowd --characters 16 --size 8 --seconds 0.5 " +
+                            "--no-render --no-frames";
+  const auto counts = [&](const std::string& extra, json* summary = nullptr) {
+    const fs::path dir = freshDir() / "run";
+    const Result r = run(crowd + " " + extra + " --out " + dir.string());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    const json s = summaryOf(dir);
+    if (summary) *summary = s;
+    return s.contains("detail") ? s["detail"]["capes_per_level_last_frame"].get<std::vector<int>>()
+                                : std::vector<int>{};
+  };
+  json plain, allFull;
+  EXPECT_TRUE(counts("", &plain).empty());
+  EXPECT_FALSE(plain.contains("detail"));
+  EXPECT_EQ(counts("--lod 1000", &allFull), (std::vector<int>{16, 0}));
+  EXPECT_EQ(allFull["state_hashes"], plain["state_hashes"]);
+  // The default viewpoint: 4 m behind the last row (z = 3 m at the start), 1.6 m up, at the middle.
+  json mixed;
+  const std::vector<int> m = counts("--lod 6,8,10", &mixed);
+  ASSERT_EQ(m.size(), 4u);
+  EXPECT_EQ(m[0] + m[1] + m[2] + m[3], 16);
+  EXPECT_GT(m[0], 0);
+  EXPECT_GT(m[3], 0);
+  EXPECT_NEAR(mixed["detail"]["viewpoint_m"][2].get<double>(), 7.0, 0.2);
+  EXPECT_NE(mixed["state_hashes"], plain["state_hashes"]);
+  EXPECT_EQ(counts("--lod 2,4 --viewpoint 0,1.6,1000"), (std::vector<int>{0, 0, 16}));
+}
+
+TEST(Crowd, BadLevelsOfDetailAreRefused) {
+  const std::string walk =
+      kWalk + " --simple-body --seconds 0.1 --no-render --out " + (freshDir() / "run").string();
+  Result r = run(walk + " --lod 5,3");
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.output.find("--lod: the distances must increase"), std::string::npos) << r.output;
+  EXPECT_EQ(run(walk + " --lod -1").exitCode, 105);
+  EXPECT_GE(run(walk + " --lod 1,2,3,4").exitCode, 100) << "CLI11: a fourth value is refused";
+  r = run(walk + " --viewpoint 0,0,0");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.output.find("--lod"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace cape::demo_test
