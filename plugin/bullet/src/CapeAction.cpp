@@ -410,11 +410,10 @@ void CapeAction::discover(btCollisionWorld* world) {
   if (!settings_.discoverColliders) return;
   // The cape's bounds at the start of the step, grown by its thickness and the discovery margin, in the
   // world (the frame's origin added in double).
-  const Points& x = cape_.state().positions;
   const btScalar grow = btScalar(cape_.settings().collisionThickness) + discoveryReach();
   const Eigen::Vector3d& o = cape_.origin();
-  const Eigen::Vector3d lo = x.colwise().minCoeff().transpose().cast<double>() + o;
-  const Eigen::Vector3d hi = x.colwise().maxCoeff().transpose().cast<double>() + o;
+  const Eigen::Vector3d lo = particleBounds(true).cast<double>() + o;
+  const Eigen::Vector3d hi = particleBounds(false).cast<double>() + o;
   DiscoveryCallback query;
   query.objects = &world->getCollisionObjectArray();
   query.lo = btVector3(btScalar(lo.x()), btScalar(lo.y()), btScalar(lo.z())) - btVector3(grow, grow, grow);
@@ -439,13 +438,23 @@ void CapeAction::discover(btCollisionWorld* world) {
   }
 }
 
+Vec3 CapeAction::particleBounds(bool low) {
+  // A sleeping cape's particles stay where they are until something wakes it (every change to its state
+  // does), so its bounds are taken once when it is found asleep and kept while it sleeps.
+  if (!boundsKept_ || !cape_.isAsleep()) {
+    const Points& x = cape_.state().positions;
+    boundsLow_ = x.colwise().minCoeff().transpose();
+    boundsHigh_ = x.colwise().maxCoeff().transpose();
+    boundsKept_ = cape_.isAsleep();
+  }
+  return low ? boundsLow_ : boundsHigh_;
+}
+
 bool CapeAction::resting() const {
   if (!cape_.isAsleep() || discoveryChanged_ || changed_) return false;
   for (const Tracked& t : tracked_) {
     // Where Bullet has it now is where the action last read it, and the motion read then is spent.
-    if (!sameTransform(t.object->getWorldTransform(), t.lastSeen) || t.jumped ||
-        !sameTransform(t.stepStart, t.stepEnd) || !sameTransform(t.stepEnd, t.segmentEnd))
-      return false;
+    if (!t.settled || !sameTransform(t.object->getWorldTransform(), t.lastSeen)) return false;
   }
   return true;
 }
@@ -761,6 +770,10 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   updatePins();
   applyInertia(dt);  // after the pins have their new targets: it shifts where they start
   buildColliders();
+  // What resting() needs of each followed pose besides where Bullet has it: whether its motion is spent
+  // (these only change in a full prepare like this one).
+  for (Tracked& t : tracked_)
+    t.settled = !t.jumped && sameTransform(t.stepStart, t.stepEnd) && sameTransform(t.stepEnd, t.segmentEnd);
   changed_ = false;
   prepareMicroseconds_ =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();

@@ -313,9 +313,10 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
     btTransform stepStart;         ///< Pose at the start of this internal step.
     btTransform stepEnd;           ///< Pose at the end of this internal step.
     bool jumped = false;           ///< Teleported in this step: no sweep.
-    bool present = false;          ///< Still in the world at this update (set by a full scan).
-    int worldIndex = -1;           ///< Index in the world's collision object array when last seen there
-                                   ///< (a hint: checked by pointer comparison before it is trusted).
+    bool settled = false;  ///< After the last full prepare: not jumped, its motion spent (start = end).
+    bool present = false;  ///< Still in the world at this update (set by a full scan).
+    int worldIndex = -1;   ///< Index in the world's collision object array when last seen there
+                           ///< (a hint: checked by pointer comparison before it is trusted).
     bool explicitCollider = false;
     bool discovered = false;  ///< Found by discovery for this step.
     bool converted = false;
@@ -352,6 +353,8 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   const btRigidBody* referenceBody() const;
   /// How far beyond the cape's bounds discovery and mesh queries look for one step of the cape, m.
   btScalar discoveryReach() const;
+  /// The particles' lowest (`low`) or highest coordinates in the cape's frame, m (kept while it sleeps).
+  Vec3 particleBounds(bool low);
 
   Cape cape_;
   CapeActionSettings settings_;
@@ -377,6 +380,8 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   /// The rendered pose of a followed body (renderPositions()) in the cape's frame, if it is in `world`.
   bool renderedPose(const btCollisionWorld& world, const btRigidBody* body, btTransform& framePose) const;
 
+  Vec3 boundsLow_ = Vec3::Zero(), boundsHigh_ = Vec3::Zero();
+  bool boundsKept_ = false;  ///< particleBounds() holds a sleeping cape's bounds.
   DetailLevel detail_;
   int skippedSteps_ = 0;      ///< Internal steps since the cape last stepped (at a coarser level).
   btScalar skippedTime_ = 0;  ///< Their time, s.
