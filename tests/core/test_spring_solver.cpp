@@ -104,7 +104,8 @@ TEST(SpringRuns, CoverEverySpringOnceInOrderWithEveryBlockInsideOneColourAndItsL
 
 TEST(SpringRuns, MostOfTheSeedGridsSpringsAreReadWithContiguousLoads) {
   // The 20 x 20 cape: rows, columns and diagonals fall into the structured layouts, which load whole
-  // neighbourhoods; only what the greedy colouring scatters is gathered.
+  // neighbourhoods; only what the greedy colouring scatters is gathered: within a colour the springs are
+  // ordered into patterned blocks where they can be (81 % of them; 75 % in the colouring's own order).
   const FabricPtr fabric = makeGrid(20, 20);
   std::size_t structured = 0, total = 0;
   for (int family = 0; family < kSpringFamilyCount; ++family) {
@@ -114,7 +115,7 @@ TEST(SpringRuns, MostOfTheSeedGridsSpringsAreReadWithContiguousLoads) {
       if (run.layout != SpringLayout::Scalar && run.layout != SpringLayout::Gathered)
         structured += run.end - run.begin;
   }
-  EXPECT_GE(static_cast<double>(structured), 0.75 * static_cast<double>(total))
+  EXPECT_GE(static_cast<double>(structured), 0.8 * static_cast<double>(total))
       << structured << " of " << total;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <numeric>
 #include <utility>
@@ -68,6 +69,73 @@ void colour(SpringSet& set, std::size_t particles) {
   }
   for (std::uint32_t c = 0; c < colours; ++c) sorted.colourStart[c + 1] += sorted.colourStart[c];
   set = std::move(sorted);
+}
+
+// Reorders the springs within each colour so that as many as can be fall into blocks of four with a vector
+// layout (blockLayout's patterns): the greedy colouring leaves a grid's rows and diagonals in build order,
+// where a row's end breaks the pattern of every block after it in that colour. Walking the colour's springs
+// by their first particle, each one not yet taken starts a block of the first pattern whose other three
+// springs are all in the colour and not yet taken; what is left keeps its order at the colour's end
+// (gathered and scalar). Springs of one colour share no particle, so their order within it changes no bit
+// of the solve.
+void orderForVectors(SpringSet& set) {
+  using Key = std::pair<std::int64_t, std::int64_t>;
+  // The four springs of each pattern starting at (p, q), as blockLayout reads them.
+  const auto patterns = [](std::int64_t p, std::int64_t q) {
+    return std::array<std::array<Key, 4>, 4>{{
+        {{{p, q}, {p + 1, q + 1}, {p + 2, q + 2}, {p + 3, q + 3}}},      // Contiguous
+        {{{p, q}, {p + 1, q - 1}, {p + 2, q + 2}, {p + 3, q + 1}}},      // PairSwapped
+        {{{p, p + 1}, {p + 2, p + 3}, {p + 4, p + 5}, {p + 6, p + 7}}},  // Interleaved
+        {{{p, p + 2}, {p + 1, p + 3}, {p + 4, p + 6}, {p + 5, p + 7}}},  // Pairs
+    }};
+  };
+  std::vector<std::uint32_t> first, second;
+  std::map<Key, std::size_t> where;  // a spring of the colour by its ends -> its index
+  std::vector<std::size_t> byFirst, order;
+  std::vector<bool> taken;
+  for (std::size_t c = 0; c < set.colourCount(); ++c) {
+    const std::size_t begin = set.colourStart[c], end = set.colourStart[c + 1];
+    where.clear();
+    byFirst.clear();
+    for (std::size_t s = begin; s < end; ++s) {
+      where.emplace(Key{set.first[s], set.second[s]}, s);
+      byFirst.push_back(s);
+    }
+    std::stable_sort(byFirst.begin(), byFirst.end(),
+                     [&](std::size_t l, std::size_t r) { return set.first[l] < set.first[r]; });
+    taken.assign(end - begin, false);
+    order.clear();
+    std::array<std::size_t, 4> block{};
+    for (std::size_t s : byFirst) {
+      if (taken[s - begin]) continue;
+      const std::int64_t p = set.first[s], q = set.second[s];
+      for (const std::array<Key, 4>& want : patterns(p, q)) {
+        if (want[0] != Key{p, q}) continue;  // the pattern does not start with this spring
+        bool all = true;
+        for (std::size_t k = 0; k < 4 && all; ++k) {
+          const auto it = where.find(want[k]);
+          all = it != where.end() && !taken[it->second - begin];
+          if (all) block[k] = it->second;
+        }
+        if (!all) continue;
+        for (std::size_t k : block) {
+          taken[k - begin] = true;
+          order.push_back(k);
+        }
+        break;
+      }
+    }
+    for (std::size_t s = begin; s < end; ++s)
+      if (!taken[s - begin]) order.push_back(s);
+    first.clear();
+    second.clear();
+    for (std::size_t s : order) {
+      first.push_back(set.first[s]);
+      second.push_back(set.second[s]);
+    }
+    std::copy(first.begin(), first.end(), set.first.begin() + static_cast<std::ptrdiff_t>(begin));
+    std::copy(second.begin(), second.end(), set.second.begin() + static_cast<std::ptrdiff_t>(begin));
+  }
 }
 
 // The vector layout of springs [s, s + 4) of one colour: Gathered when their indices follow no pattern.
@@ -289,6 +357,7 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
   if (springCount() == 0) return Status::error("Fabric: no springs");
   for (auto& set : springs_) {
     colour(set, n);
+    orderForVectors(set);
     planRuns(set);
   }
   for (auto& set : springs_) {
