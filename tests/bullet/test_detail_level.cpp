@@ -199,6 +199,13 @@ TEST(CapeGroupDetail, BandsByDistanceWithHysteresis) {
   w.world->stepSimulation(kFixed, 8, kFixed);
   EXPECT_EQ(capes[3]->detailLevel(), frame);
   EXPECT_EQ(group.detailCounts(), (std::vector<std::size_t>{1, 1, 2}));
+  // A cape removed keeps the level it had; the others keep theirs.
+  group.remove(capes[1].get());
+  w.world->stepSimulation(kFixed, 8, kFixed);
+  EXPECT_EQ(group.detailCounts(), (std::vector<std::size_t>{1, 0, 2}));
+  EXPECT_EQ(capes[1]->detailLevel(), half);
+  EXPECT_EQ(capes[3]->detailLevel(), frame);
+  group.add(capes[1].get());
   ASSERT_TRUE(group.setDetailPolicy(btVector3(0, 1, 0), {}).ok());
   for (auto& c : capes) EXPECT_EQ(c->detailLevel(), DetailLevel());
   EXPECT_TRUE(group.detailCounts().empty());

@@ -35,7 +35,8 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
 
   /// Adds a cape (not owned; it must outlive its membership and must not be added to the world itself).
   void add(CapeAction* cape);
-  /// Removes a cape from the group (not destroyed; nothing happens if it is not a member).
+  /// Removes a cape from the group (not destroyed; nothing happens if it is not a member). It keeps the
+  /// level of detail it had.
   void remove(CapeAction* cape);
   /// The member capes, in the order they were added (cape i runs on worker i % threadCount()).
   const std::vector<CapeAction*>& capes() const { return capes_; }
