@@ -104,6 +104,7 @@ class BulletCapeRun final : public SceneRun {
         std::move(bands));
   }
   std::vector<std::size_t> detailCounts() const override { return group_->detailCounts(); }
+  void setParallelPrepare(bool parallel) { group_->setParallelPrepare(parallel); }
   Eigen::Vector3d detailViewpoint() const override { return viewpoint_; }
 
   /// The same motion constraints on every character's cape (one fabric: one weight map fits them all).
@@ -173,6 +174,7 @@ std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& e
   if (!scene) return nullptr;
   for (const std::string& n : scene->notes()) std::printf("cape_walk: %s\n", n.c_str());
   auto run = std::make_unique<BulletCapeRun>(std::move(scene), options.threads);
+  run->setParallelPrepare(options.parallelPrepare);
   if (!run->build(run->settings(), options.scene, error)) return nullptr;
   if (Status s = run->setDetail(options.lodDistances, options.viewpoint); !s.ok()) {
     error = "--lod: " + s.message();

@@ -40,6 +40,7 @@ struct RunOptions {
   double seconds = -1.0;  ///< < 0: the scene's own length
   int characters = 1;     ///< crowd size
   int threads = 1;
+  bool parallelPrepare = false;  ///< the capes' prepare on the pool too (--parallel-prepare)
   CapeSettings settings;
   bool simpleBody = false;
   std::string urdf;                      ///< empty: the shipped humanoid

@@ -117,6 +117,10 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "worker threads stepping the capes")
       ->transform(strictInteger(1, 256))
       ->capture_default_str();
+  bool parallelPrepare = false;
+  app.add_flag("--parallel-prepare", parallelPrepare,
+               "with --threads above 1, the capes read the world (discovery, poses) on the workers too "
+               "(CapeGroup::setParallelPrepare; the same results)");
   app.add_option("--out", out,
                  "output folder (default: a fresh runs/<scene>-<time> folder under the current one). A "
                  "folder that holds a previous cape_walk run (only metrics.csv, summary.json, picture.png, "
@@ -151,6 +155,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   o.threads = threads;
+  o.parallelPrepare = parallelPrepare;
   for (std::size_t k = 1; k < lodDistances.size(); ++k) {
     if (!(lodDistances[k] > lodDistances[k - 1])) {
       std::fprintf(stderr, "cape_walk: --lod: the distances must increase (%g is not beyond %g)\n",

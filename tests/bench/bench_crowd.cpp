@@ -2,7 +2,8 @@
 // bodies) on docs/SCENES.md's square grid 2 m apart (rows of ceil(sqrt K)), walking the walk's motion in one
 // btDiscreteDynamicsWorld with a static ground plane, each wearing a 20 x 20 cape (cape::makeCapeRig, pinned
 // at the corners to its shoulders) as a CapeAction, all in one cape::bullet::CapeGroup of T workers. One
-// iteration is one 1/60 s frame, stepSimulation(1/60, 8, 1/240), after a simulated second of warm-up.
+// iteration is one 1/60 s frame, stepSimulation(1/60, 8, 1/240), after a simulated second of warm-up. P = 1:
+// the capes' prepare runs on the pool too (CapeGroup::setParallelPrepare), not on the world's thread.
 //
 // Reported per frame (means over the timed frames; _p50 their medians):
 //   cape_us           the capes' wall time: the group's updateAction calls (every cape's prepare on the
@@ -24,8 +25,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <initializer_list>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -76,7 +79,8 @@ class TimedGroup final : public btActionInterface {
 };
 
 struct Crowd {
-  Crowd(int count, int threads) : group(threads), timed(group) {
+  Crowd(int count, int threads, bool parallelPrepare = false) : group(threads), timed(group) {
+    group.setParallelPrepare(parallelPrepare);
     world.setGravity(btVector3(0, btScalar(-9.8), 0));
     world.addRigidBody(&ground);
     const cape::CapeRig rig = cape::makeCapeRig(20, cape::PinLayout::Corners);
@@ -143,7 +147,7 @@ struct Crowd {
 void BM_CrowdFrame(benchmark::State& state) {
   const int count = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
-  Crowd crowd(count, threads);
+  Crowd crowd(count, threads, state.range(2) != 0);
   for (int k = 0; k < 60; ++k) crowd.advance();  // a simulated second of warm-up
   std::vector<double> cape, advance, bullet, frame;
   for (auto _ : state) {
@@ -171,7 +175,7 @@ void BM_CrowdFrame(benchmark::State& state) {
 void BM_CrowdFrameDetail(benchmark::State& state) {
   const int count = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
-  Crowd crowd(count, threads);
+  Crowd crowd(count, threads, state.range(2) != 0);
   btScalar front = 0;
   for (int k = 0; k < count; ++k) front = std::max(front, btScalar(gridOffset(k, count).z()));
   using cape::bullet::DetailLevel;
@@ -202,14 +206,16 @@ void BM_CrowdFrameDetail(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_CrowdFrameDetail)
-    ->ArgNames({"K", "T"})
-    ->ArgsProduct({{100, 1000}, {1, 2}})
-    ->Iterations(120)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_CrowdFrame)
-    ->ArgNames({"K", "T"})
-    ->ArgsProduct({{16, 100, 1000}, {1, 2}})
-    ->Iterations(120)
-    ->Unit(benchmark::kMillisecond);
+/// K in `counts` on 1 thread, on 2, and on 2 with the prepare on the pool too (P:
+/// CapeGroup::setParallelPrepare).
+void crowdArgs(benchmark::internal::Benchmark* b, std::initializer_list<int> counts) {
+  b->ArgNames({"K", "T", "P"});
+  for (int k : counts)
+    for (const auto& [threads, parallel] : {std::pair{1, 0}, std::pair{2, 0}, std::pair{2, 1}})
+      b->Args({k, threads, parallel});
+  b->Iterations(120)->Unit(benchmark::kMillisecond);
+}
+
+BENCHMARK(BM_CrowdFrameDetail)->Apply([](benchmark::internal::Benchmark* b) { crowdArgs(b, {100, 1000}); });
+BENCHMARK(BM_CrowdFrame)->Apply([](benchmark::internal::Benchmark* b) { crowdArgs(b, {16, 100, 1000}); });
 BENCHMARK_MAIN();

@@ -7,6 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <string>
+#include <thread>
+#include <utility>
 
 using namespace capetest;
 using cape::bullet::CapeAction;
@@ -15,11 +18,12 @@ namespace {
 
 /// Two capes pinned to two kinematic bodies that walk and turn, over a sphere each, stepped by a group
 /// of `threads`; returns every cape's final positions.
-std::vector<cape::Points> runGroup(int threads) {
+std::vector<cape::Points> runGroup(int threads, bool parallelPrepare = false) {
   World w;
   std::vector<std::unique_ptr<CapeAction>> capes;
   std::vector<btRigidBody*> bodies;
   cape::bullet::CapeGroup group(threads);
+  group.setParallelPrepare(parallelPrepare);
   for (int k = 0; k < 2; ++k) {
     const btVector3 at(btScalar(2 * k), btScalar(1.5), 0);
     bodies.push_back(w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)),
@@ -63,6 +67,51 @@ TEST(CapeGroup, OneAndTwoThreadsGiveIdenticalBits) {
   // Each body turns at its own rate, so the two capes differ: the comparison is not of two copies.
   EXPECT_GT((one[0].rowwise() - one[0].row(0)).norm(), 0.0f);
   EXPECT_GT((one[0] - one[1]).cwiseAbs().maxCoeff(), 0.0f);
+}
+
+TEST(CapeGroup, APreparePutOnThePoolGivesTheSameBits) {
+  const std::vector<cape::Points> serial = runGroup(2), parallel = runGroup(2, true), one = runGroup(1, true);
+  ASSERT_EQ(serial.size(), parallel.size());
+  for (std::size_t k = 0; k < serial.size(); ++k) {
+    ASSERT_TRUE(parallel[k].allFinite());
+    EXPECT_EQ(
+        0, std::memcmp(serial[k].data(), parallel[k].data(), sizeof(float) * std::size_t(serial[k].size())))
+        << "cape " << k;
+    EXPECT_EQ(0, std::memcmp(serial[k].data(), one[k].data(), sizeof(float) * std::size_t(serial[k].size())))
+        << "cape " << k;
+  }
+}
+
+TEST(CapeGroup, WarningsOfAParallelPrepareAreSaidOnceOnTheCallingThread) {
+  // Two capes pinned to one body, which is removed from the world while they hang from it: each cape says so
+  // once, through its handler, on the thread that steps the world.
+  World w;
+  btRigidBody* body = w.addKinematic(new btSphereShape(0.05f),
+                                     btTransform(btQuaternion::getIdentity(), btVector3(0, 1.5f, 0)));
+  std::vector<std::unique_ptr<CapeAction>> capes;
+  std::vector<std::pair<std::thread::id, std::string>> said;
+  cape::bullet::CapeGroup group(2);
+  group.setParallelPrepare(true);
+  for (int k = 0; k < 2; ++k) {
+    capes.push_back(std::make_unique<CapeAction>(
+        cornerFabric(), cape::CapeSettings(),
+        btTransform(btQuaternion::getIdentity(), btVector3(-0.3f, 1.5f, 0.15f))));
+    capes.back()->attachRow(0, body);
+    capes.back()->setWarningHandler(
+        [&said](const std::string& m) { said.emplace_back(std::this_thread::get_id(), m); });
+    group.add(capes.back().get());
+  }
+  w.world->addAction(&group);
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  w.world->removeRigidBody(body);  // the world fixture deletes it at the end
+  for (int frame = 0; frame < 5; ++frame) w.world->stepSimulation(kFrame, 8, kFixed);
+  w.world->removeAction(&group);
+  ASSERT_EQ(said.size(), 2u);
+  for (const auto& [thread, message] : said) {
+    EXPECT_EQ(thread, std::this_thread::get_id());
+    EXPECT_NE(message.find("removed from the world"), std::string::npos) << message;
+  }
+  for (auto& c : capes) EXPECT_TRUE(c->attachments().empty());
 }
 
 TEST(CapeGroup, SameResultAsTheCapeAddedAlone) {

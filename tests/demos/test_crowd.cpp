@@ -199,6 +199,21 @@ TEST(Crowd, LevelsOfDetailByDistanceFromTheViewpoint) {
   EXPECT_EQ(counts("--lod 2,4 --viewpoint 0,1.6,1000"), (std::vector<int>{0, 0, 16}));
 }
 
+TEST(Crowd, APrepareOnTheWorkersGivesTheSameCapes) {
+  const std::string crowd = kWalk + " --simple-body --scene crowd --characters 9 --size 8 --seconds 0.5 " +
+                            "--no-render --no-frames --lod 3,5,7";
+  std::vector<json> hashes;
+  for (const char* extra : {"--threads 1", "--threads 2", "--threads 2 --parallel-prepare"}) {
+    const fs::path dir = freshDir() / "run";
+    const Result r = run(crowd + " " + extra + " --out " + dir.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    hashes.push_back(summaryOf(dir)["state_hashes"]);
+  }
+  EXPECT_EQ(hashes[0].size(), 9u);
+  EXPECT_EQ(hashes[1], hashes[0]);
+  EXPECT_EQ(hashes[2], hashes[0]);
+}
+
 TEST(Crowd, BadLevelsOfDetailAreRefused) {
   const std::string walk =
       kWalk + " --simple-body --seconds 0.1 --no-render --out " + (freshDir() / "run").string();

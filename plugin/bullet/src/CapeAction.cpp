@@ -208,7 +208,16 @@ CapeAction::~CapeAction() = default;
 
 void CapeAction::warnOnce(const std::string& key, const std::string& message) {
   if (!warned_.insert(key).second) return;
-  if (warn_) warn_(message);
+  if (deferWarnings_)
+    deferredWarnings_.push_back(message);
+  else if (warn_)
+    warn_(message);
+}
+
+void CapeAction::sayDeferredWarnings() {
+  for (const std::string& message : deferredWarnings_)
+    if (warn_) warn_(message);
+  deferredWarnings_.clear();
 }
 
 btVector3 CapeAction::toWorld(const Vec3& framePoint) const {

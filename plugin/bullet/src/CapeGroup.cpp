@@ -37,8 +37,10 @@ void CapeGroup::remove(CapeAction* cape) {
 
 void CapeGroup::work(int worker) {
   for (std::size_t i = static_cast<std::size_t>(worker); i < capes_.size();
-       i += static_cast<std::size_t>(threadCount_))
+       i += static_cast<std::size_t>(threadCount_)) {
+    if (world_ != nullptr) capes_[i]->prepare(world_, dt_);  // a parallel prepare
     capes_[i]->advance(dt_);
+  }
 }
 
 void CapeGroup::runWorker(int worker) {
@@ -115,13 +117,17 @@ void CapeGroup::applyDetailPolicy() {
 
 void CapeGroup::updateAction(btCollisionWorld* world, btScalar dt) {
   if (!bands_.empty()) applyDetailPolicy();
-  // Reading the world (bodies, discovery) stays on this thread.
-  for (CapeAction* cape : capes_) cape->prepare(world, dt);
+  const bool parallel = parallelPrepare_ && !threads_.empty() && capes_.size() >= 2;
+  // Reading the world (bodies, discovery) stays on this thread, unless asked otherwise.
+  world_ = parallel ? world : nullptr;
+  if (!parallel)
+    for (CapeAction* cape : capes_) cape->prepare(world, dt);
   const auto start = std::chrono::steady_clock::now();
   dt_ = dt;
   if (threads_.empty() || capes_.size() < 2) {
     for (CapeAction* cape : capes_) cape->advance(dt);
   } else {
+    for (CapeAction* cape : capes_) cape->deferWarnings_ = parallel;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       pending_ = static_cast<int>(threads_.size());
@@ -129,8 +135,15 @@ void CapeGroup::updateAction(btCollisionWorld* world, btScalar dt) {
     }
     start_.notify_all();
     work(0);
-    std::unique_lock<std::mutex> lock(mutex_);
-    done_.wait(lock, [&] { return pending_ == 0; });
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      done_.wait(lock, [&] { return pending_ == 0; });
+    }
+    world_ = nullptr;
+    for (CapeAction* cape : capes_) {
+      cape->deferWarnings_ = false;
+      cape->sayDeferredWarnings();
+    }
   }
   lastStepMicroseconds_ =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();

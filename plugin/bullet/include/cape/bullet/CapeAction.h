@@ -350,6 +350,9 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   void followReference();
   void reportGuard();
   void warnOnce(const std::string& key, const std::string& message);
+  /// Warnings held back while prepare() runs on a worker of a CapeGroup, said on its calling thread.
+  void sayDeferredWarnings();
+  friend class CapeGroup;  // defers warnings around a parallel prepare
   const btRigidBody* referenceBody() const;
   /// How far beyond the cape's bounds discovery and mesh queries look for one step of the cape, m.
   btScalar discoveryReach() const;
@@ -360,6 +363,8 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   CapeActionSettings settings_;
   WarningHandler warn_;
   std::unordered_set<std::string> warned_;
+  bool deferWarnings_ = false;  ///< warnOnce() holds its messages in deferred_.
+  std::vector<std::string> deferredWarnings_;
 
   std::vector<Attachment> attachments_;
   std::vector<std::size_t> pinIndex_;  ///< Core pin index of each attachment.

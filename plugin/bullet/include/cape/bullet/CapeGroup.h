@@ -67,7 +67,20 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   /// (empty without a policy).
   const std::vector<std::size_t>& detailCounts() const { return bandCounts_; }
 
-  /// Wall time of the last parallel advance of all capes, microseconds.
+  // --- Parallel prepare --------------------------------------------------------------------------------
+  /// Prepare the capes on the pool too (off by default): each worker prepares and then advances its own
+  /// capes, with no wait between the two halves, instead of every prepare() running first on the calling
+  /// thread. The results are the same bits. It needs the world's shapes to answer queries from several
+  /// threads at once, as Bullet's own do during actions: the broadphase's AABB test keeps its traversal
+  /// stack on the caller's stack, and btBvhTriangleMeshShape's and btHeightfieldTerrainShape's
+  /// processAllTriangles only read (a mesh interface of your own that locks or caches must allow it). The
+  /// capes' warnings are held back and given to their handlers on the calling thread, cape by cape, after
+  /// the step.
+  void setParallelPrepare(bool parallel) { parallelPrepare_ = parallel; }
+  bool parallelPrepare() const { return parallelPrepare_; }
+
+  /// Wall time of the last parallel advance of all capes (with their prepare under setParallelPrepare),
+  /// microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
 
  private:
@@ -85,6 +98,8 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   int pending_ = 0;               ///< Workers (threads) still busy with the current step.
   bool stopping_ = false;
   btScalar dt_ = 0;
+  btCollisionWorld* world_ = nullptr;  ///< The world of the step in progress (parallel prepare).
+  bool parallelPrepare_ = false;
   btVector3 viewpoint_{0, 0, 0};
   std::vector<DetailBand> bands_;
   btScalar hysteresis_ = 0;
