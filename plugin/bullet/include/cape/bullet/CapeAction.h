@@ -128,9 +128,11 @@ struct DetailLevel {
   Status validate() const;
   /// Full detail: every internal step, the settings' substeps.
   bool full() const { return stepInterval == 1 && substeps == 0; }
+  /// The same interval and substeps.
   bool operator==(const DetailLevel& o) const {
     return stepInterval == o.stepInterval && substeps == o.substeps;
   }
+  /// A different interval or substeps.
   bool operator!=(const DetailLevel& o) const { return !(*this == o); }
 };
 

@@ -20,7 +20,7 @@ namespace cape::bullet {
 /// the viewpoint step at `level`.
 struct DetailBand {
   btScalar distance = 0;  ///< m from the viewpoint.
-  DetailLevel level;
+  DetailLevel level;      ///< The level of the capes beyond `distance`.
 };
 
 /// Several capes stepped with one Bullet world on a persistent thread pool, bitwise identical results on any
@@ -77,6 +77,7 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   /// capes' warnings are held back and given to their handlers on the calling thread, cape by cape, after
   /// the step.
   void setParallelPrepare(bool parallel) { parallelPrepare_ = parallel; }
+  /// Whether the capes are prepared on the pool (setParallelPrepare).
   bool parallelPrepare() const { return parallelPrepare_; }
 
   /// Wall time of the last parallel advance of all capes (with their prepare under setParallelPrepare),
