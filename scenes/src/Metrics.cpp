@@ -2,7 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace cape {
 
@@ -241,36 +246,26 @@ bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Ve
 
 namespace {
 
-// The spatial hash of the self-intersection count: cubic cells of kCellPerExtent times the mean triangle
-// extent (the largest side of its box), indices clamped to [0, kCellsPerAxis) so that huge or far
-// coordinates stay integers, packed into one key, and a power-of-two table of buckets the keys hash into.
-constexpr double kCellPerExtent = 1.5;
-constexpr int kCellBits = 21;
-constexpr std::int32_t kCellsPerAxis = 1 << (kCellBits - 1);
-// A triangle covering more cells than this (a sliver much longer than the mean) is tested against every
-// triangle instead of being hashed into all of them.
-constexpr std::int64_t kMaxCellsPerTriangle = 64;
+// The grid of the self-intersection count: cubic cells as large as the largest triangle box (a box's
+// largest side), but at most kMaxCellPerMean times the mean one (larger triangles are loose), indices
+// clamped to [0, kCellsPerAxis) so that huge or far coordinates stay integers.
+constexpr double kMaxCellPerMean = 2.0;
+constexpr std::int32_t kCellsPerAxis = 1 << 20;
+// The arrays of the cell order are this much longer than the triangles in it, so that four-wide loads at
+// the last triangles stay inside them.
+constexpr std::size_t kPad = 3;
+// The radix sort's digit.
+constexpr int kDigitBits = 8;
 
 std::int32_t cellOf(float v, double origin, double inverseSize) {
-  // Monotone in v (a rounded difference and product, the clamp and the truncation of a value >= 0 are),
-  // which the pair rule relies on. (Truncation rather than std::floor, a libm call without SSE4.1.)
+  // Monotone in v (a rounded difference and product, the clamp and the truncation of a value >= 0 are).
+  // (Truncation rather than std::floor, a libm call without SSE4.1.)
   const double c = (static_cast<double>(v) - origin) * inverseSize;
   return static_cast<std::int32_t>(std::clamp(c, 0.0, static_cast<double>(kCellsPerAxis - 1)));
 }
 
-std::uint64_t cellKey(std::int32_t i, std::int32_t j, std::int32_t k) {
-  return static_cast<std::uint64_t>(i) << (2 * kCellBits) | static_cast<std::uint64_t>(j) << kCellBits |
-         static_cast<std::uint64_t>(k);
-}
-
-std::uint32_t bucketOf(std::uint64_t key, std::uint32_t mask) {
-  std::uint64_t h = key * 0x9E3779B97F4A7C15ull;
-  h ^= h >> 29;
-  return static_cast<std::uint32_t>(h >> 32) & mask;
-}
-
-// What the count does with a triangle (SelfIntersectionCounter::isLoose_): hashed; loose as it covers too
-// many cells; or loose and unboxed as it is not finite (tested against every other triangle without a box
+// What the count does with a triangle (SelfIntersectionCounter::isLoose_): hashed; loose as it is larger than
+// the cells; or loose and unboxed as it is not finite (tested against every other triangle without a box
 // test, as the brute-force count would).
 constexpr std::uint8_t kHashed = 0, kTooLarge = 1, kUnboxed = 2;
 
@@ -285,19 +280,119 @@ bool boxesOverlap(const Box& a, const Box& b) {
            b.lo[2] > a.hi[2] || b.hi[2] < a.lo[2]);
 }
 
+double largestSide(const float lo[3], const float hi[3]) {
+  return std::max({static_cast<double>(hi[0]) - lo[0], static_cast<double>(hi[1]) - lo[1],
+                   static_cast<double>(hi[2]) - lo[2]});
+}
+
 }  // namespace
+
+void SelfIntersectionCounter::testAgainst(const Points& x, std::uint32_t a, const Run* runs, int runCount) {
+  // A pair: boxes that overlap (closed), no shared vertex (most pairs that overlap share one), then the
+  // exact test with the lower triangle first, as a brute-force loop over i < j calls it (its rounding is not
+  // symmetric).
+  const auto exact = [&](std::uint32_t b) {
+    const std::uint32_t p = triangle_[a] < triangle_[b] ? a : b, q = p == a ? b : a;
+    if (intervalTest(x.row(vertex_[0][p]), x.row(vertex_[1][p]), x.row(vertex_[2][p]), x.row(vertex_[0][q]),
+                     x.row(vertex_[1][q]), x.row(vertex_[2][q])))
+      ++found_;
+  };
+#if defined(__SSE2__)
+  // Four at a time: the six box comparisons and the nine corner comparisons as lane masks.
+  const __m128 alo[3] = {_mm_set1_ps(lo_[0][a]), _mm_set1_ps(lo_[1][a]), _mm_set1_ps(lo_[2][a])};
+  const __m128 ahi[3] = {_mm_set1_ps(hi_[0][a]), _mm_set1_ps(hi_[1][a]), _mm_set1_ps(hi_[2][a])};
+  const __m128i av[3] = {_mm_set1_epi32(static_cast<int>(vertex_[0][a])),
+                         _mm_set1_epi32(static_cast<int>(vertex_[1][a])),
+                         _mm_set1_epi32(static_cast<int>(vertex_[2][a]))};
+  for (int r = 0; r < runCount; ++r) {
+    const std::uint32_t end = runs[r].end;
+    for (std::uint32_t j = runs[r].begin; j < end; j += 4) {
+      __m128 overlap = _mm_castsi128_ps(_mm_set1_epi32(-1));
+      __m128i shared = _mm_setzero_si128();
+      for (int k = 0; k < 3; ++k) {
+        overlap = _mm_and_ps(overlap, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(&lo_[k][j]), ahi[k]),
+                                                 _mm_cmpge_ps(_mm_loadu_ps(&hi_[k][j]), alo[k])));
+        const __m128i bv = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&vertex_[k][j]));
+        shared = _mm_or_si128(
+            shared, _mm_or_si128(_mm_cmpeq_epi32(bv, av[0]),
+                                 _mm_or_si128(_mm_cmpeq_epi32(bv, av[1]), _mm_cmpeq_epi32(bv, av[2]))));
+      }
+      int lanes = _mm_movemask_ps(_mm_andnot_ps(_mm_castsi128_ps(shared), overlap));
+      if (end - j < 4) lanes &= (1 << (end - j)) - 1;
+      for (; lanes != 0; lanes &= lanes - 1) exact(j + static_cast<std::uint32_t>(__builtin_ctz(lanes)));
+    }
+  }
+#else
+  for (int r = 0; r < runCount; ++r)
+    for (std::uint32_t b = runs[r].begin; b < runs[r].end; ++b) {
+      bool overlap = true, shared = false;
+      for (int k = 0; k < 3; ++k) {
+        overlap = overlap && lo_[k][b] <= hi_[k][a] && hi_[k][b] >= lo_[k][a];
+        shared = shared || vertex_[k][b] == vertex_[0][a] || vertex_[k][b] == vertex_[1][a] ||
+                 vertex_[k][b] == vertex_[2][a];
+      }
+      if (overlap && !shared) exact(b);
+    }
+#endif
+}
+
+void SelfIntersectionCounter::sortByCell(const std::vector<std::uint32_t>& tri, std::uint64_t largestKey) {
+  // A stable least-significant-digit radix sort of the keys (triangles in ascending order to start with, so
+  // ascending within each cell after), as many digits as the largest key has.
+  const std::size_t n = order_[0].size();
+  int passes = 0;
+  while (passes * kDigitBits < 64 && (largestKey >> (passes * kDigitBits)) != 0) ++passes;
+  keys_[1].resize(n);
+  order_[1].resize(n);
+  int from = 0;
+  for (int pass = 0; pass < passes; ++pass, from ^= 1) {
+    const int shift = pass * kDigitBits;
+    histogram_.assign(std::size_t{1} << kDigitBits, 0);
+    for (std::size_t i = 0; i < n; ++i) ++histogram_[(keys_[from][i] >> shift) & ((1u << kDigitBits) - 1)];
+    std::uint32_t sum = 0;
+    for (std::uint32_t& h : histogram_) {
+      const std::uint32_t c = h;
+      h = sum;
+      sum += c;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t at = histogram_[(keys_[from][i] >> shift) & ((1u << kDigitBits) - 1)]++;
+      keys_[from ^ 1][at] = keys_[from][i];
+      order_[from ^ 1][at] = order_[from][i];
+    }
+  }
+  // The structure of arrays in that order; the padding past the end is never read as a match (lanes past a
+  // run are masked off).
+  for (int k = 0; k < 3; ++k) {
+    lo_[k].assign(n + kPad, 0.0f);
+    hi_[k].assign(n + kPad, 0.0f);
+    vertex_[k].assign(n + kPad, 0u);
+  }
+  triangle_.resize(n);
+  key_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t t = order_[from][i];
+    for (int k = 0; k < 3; ++k) {
+      lo_[k][i] = boxes_[t].lo[k];
+      hi_[k][i] = boxes_[t].hi[k];
+      vertex_[k][i] = tri[3 * t + static_cast<std::size_t>(k)];
+    }
+    triangle_[i] = t;
+    key_[i] = keys_[from][i];
+  }
+}
 
 int SelfIntersectionCounter::count(const Fabric& fabric, const Points& x) {
   const std::vector<std::uint32_t>& tri = fabric.triangles();
   const std::size_t nt = tri.size() / 3;
   boxes_.resize(nt);
+  cells_.resize(3 * nt);
   isLoose_.assign(nt, kHashed);
   loose_.clear();
-  entries_.clear();
 
-  // Boxes, their mean extent and the box of them all (finite triangles only: the others are loose and
-  // unboxed).
-  double extentSum = 0.0;
+  // Boxes, their mean and largest extent and the box of them all (finite triangles only: the others are
+  // loose and unboxed).
+  double extentSum = 0.0, extentMax = 0.0;
   std::size_t finite = 0;
   float all[2][3] = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
   for (std::size_t t = 0; t < nt; ++t) {
@@ -314,8 +409,9 @@ int SelfIntersectionCounter::count(const Fabric& fabric, const Points& x) {
       loose_.push_back(static_cast<std::uint32_t>(t));
       continue;
     }
-    extentSum += std::max({static_cast<double>(b.hi[0]) - b.lo[0], static_cast<double>(b.hi[1]) - b.lo[1],
-                           static_cast<double>(b.hi[2]) - b.lo[2]});
+    const double extent = largestSide(b.lo, b.hi);
+    extentSum += extent;
+    extentMax = std::max(extentMax, extent);
     for (int k = 0; k < 3; ++k) {
       all[0][k] = finite == 0 ? b.lo[k] : std::min(all[0][k], b.lo[k]);
       all[1][k] = finite == 0 ? b.hi[k] : std::max(all[1][k], b.hi[k]);
@@ -323,105 +419,76 @@ int SelfIntersectionCounter::count(const Fabric& fabric, const Points& x) {
     ++finite;
   }
 
-  // The cells: from the mean extent, or coarser if the boxes span more than kCellsPerAxis of them; all in
-  // one cell when everything is one point.
+  // The cell size: the largest extent (at most kMaxCellPerMean times the mean one), or coarser if the boxes
+  // span more than kCellsPerAxis cells. Two boxes of extents up to `size` that overlap have least corners
+  // at most `size` apart on every axis, so their cells differ by at most one on each: the cells are made
+  // larger by a millionth, so that no rounding of the cell index (well under a millionth of a cell below
+  // kCellsPerAxis) can make that two.
   double span = 0.0;
   for (int k = 0; k < 3; ++k) span = std::max(span, static_cast<double>(all[1][k]) - all[0][k]);
   const double mean = finite > 0 ? extentSum / static_cast<double>(finite) : 0.0;
-  const double size = std::max(kCellPerExtent * mean, span / static_cast<double>(kCellsPerAxis - 1));
-  const double inverse = size > 0.0 ? 1.0 / size : 0.0;
-  std::size_t entries = 0;
+  const double size =
+      std::max(std::min(extentMax, kMaxCellPerMean * mean), span / static_cast<double>(kCellsPerAxis - 1));
+  const double inverse = size > 0.0 ? 1.0 / (size * (1.0 + 1e-6)) : 0.0;
+  std::int32_t largest[3] = {0, 0, 0};
+  order_[0].clear();
   for (std::size_t t = 0; t < nt; ++t) {
     if (isLoose_[t] != kHashed) continue;
-    Box& b = boxes_[t];
-    std::int64_t cells = 1;
-    for (int k = 0; k < 3; ++k) {
-      b.cellLo[k] = cellOf(b.lo[k], all[0][k], inverse);
-      b.cellHi[k] = cellOf(b.hi[k], all[0][k], inverse);
-      cells *= b.cellHi[k] - b.cellLo[k] + 1;
-    }
-    if (cells > kMaxCellsPerTriangle) {
+    const Box& b = boxes_[t];
+    if (largestSide(b.lo, b.hi) > size) {
       isLoose_[t] = kTooLarge;
       loose_.push_back(static_cast<std::uint32_t>(t));
       continue;
     }
-    entries += static_cast<std::size_t>(cells);
+    for (int k = 0; k < 3; ++k) {
+      cells_[3 * t + static_cast<std::size_t>(k)] = cellOf(b.lo[k], all[0][k], inverse);
+      largest[k] = std::max(largest[k], cells_[3 * t + static_cast<std::size_t>(k)]);
+    }
+    order_[0].push_back(static_cast<std::uint32_t>(t));
   }
-  // About one bucket per entry: a triangle covers a few cells and a cell holds a few triangles, so most
-  // buckets hold one cell.
-  std::size_t buckets = 1;
-  while (buckets < entries) buckets *= 2;
-  const std::uint32_t mask = static_cast<std::uint32_t>(buckets - 1);
+  // A cell's key, (i * dy + j + 1) * dz + k + 1, orders the cells by i, then j, then k; a free index on
+  // either side of j and k keeps the neighbours' keys from wrapping into another row.
+  const std::uint64_t dy = static_cast<std::uint64_t>(largest[1]) + 3;
+  const std::uint64_t dz = static_cast<std::uint64_t>(largest[2]) + 3;
+  keys_[0].resize(order_[0].size());
+  std::uint64_t largestKey = 0;
+  for (std::size_t i = 0; i < order_[0].size(); ++i) {
+    const std::int32_t* c = &cells_[3 * static_cast<std::size_t>(order_[0][i])];
+    keys_[0][i] = (static_cast<std::uint64_t>(c[0]) * dy + static_cast<std::uint64_t>(c[1]) + 1) * dz +
+                  static_cast<std::uint64_t>(c[2]) + 1;
+    largestKey = std::max(largestKey, keys_[0][i]);
+  }
+  sortByCell(tri, largestKey);
 
-  // One entry per hashed triangle and cell it covers, in triangle order, counted per bucket.
-  bucketStart_.assign(buckets, 0);
-  for (std::size_t t = 0; t < nt; ++t) {
-    if (isLoose_[t] != kHashed) continue;
-    const Box& b = boxes_[t];
-    for (std::int32_t i = b.cellLo[0]; i <= b.cellHi[0]; ++i)
-      for (std::int32_t j = b.cellLo[1]; j <= b.cellHi[1]; ++j)
-        for (std::int32_t k = b.cellLo[2]; k <= b.cellHi[2]; ++k) {
-          const std::uint64_t key = cellKey(i, j, k);
-          const std::uint32_t bucket = bucketOf(key, mask);
-          entries_.push_back({key, static_cast<std::uint32_t>(t), bucket});
-          ++bucketStart_[bucket];
-        }
-  }
-  // Counting sort, stable: each bucket's entries in ascending triangle order, each with a copy of its
-  // triangle's box (the pair loop reads them in order). Afterwards bucketStart_[h] is where bucket h ends
-  // (and h + 1 begins).
-  std::uint32_t sum = 0;
-  for (std::uint32_t& s : bucketStart_) {
-    const std::uint32_t n = s;
-    s = sum;
-    sum += n;
-  }
-  sorted_.resize(entries_.size());
-  for (const Entry& e : entries_) {
-    const Box& b = boxes_[e.triangle];
-    const std::uint32_t* v = &tri[3 * e.triangle];
-    sorted_[bucketStart_[e.bucket]++] = {{b.lo[0], b.lo[1], b.lo[2]},
-                                         {b.hi[0], b.hi[1], b.hi[2]},
-                                         {b.cellLo[0], b.cellLo[1], b.cellLo[2]},
-                                         {v[0], v[1], v[2]},
-                                         e.triangle,
-                                         e.key};
-  }
-
-  int found = 0;
-  // Pairs in a cell: a pair whose boxes overlap is tested in the one cell holding the least corner of the
-  // boxes' intersection, the cell (max of the two least cells, axis by axis) both cover. The cell
-  // filters first, then the box and shared-vertex ones together (most pairs that overlap share a vertex).
-  const std::uint32_t total = static_cast<std::uint32_t>(sorted_.size());
+  found_ = 0;
+  // Every cell (a run of one key) with the rest of itself and its 13 forward neighbours: the cell after it
+  // in its row (k + 1), the three of the next row (j + 1; k - 1 to k + 1) and the nine of the next plane
+  // (i + 1; j - 1 to j + 1, each k - 1 to k + 1). The keys of each such group are consecutive, so each is one
+  // run of the order; as the cells come in ascending order, so do the runs, found by cursors that only move
+  // forward.
+  const std::uint32_t total = static_cast<std::uint32_t>(key_.size());
+  const std::uint64_t rowOffset[4] = {dz, dy * dz - dz, dy * dz, dy * dz + dz};
+  std::uint32_t from[4] = {0, 0, 0, 0}, to[4] = {0, 0, 0, 0};
   for (std::uint32_t begin = 0, end = 0; begin < total; begin = end) {
-    const std::uint32_t h = bucketOf(sorted_[begin].key, mask);
-    end = bucketStart_[h];
-    for (std::uint32_t i = begin; i + 1 < end; ++i) {
-      const Candidate& ca = sorted_[i];
-      const std::uint64_t key = ca.key;
-      const std::int32_t cell[3] = {static_cast<std::int32_t>(key >> (2 * kCellBits)),
-                                    static_cast<std::int32_t>(key >> kCellBits & ((1u << kCellBits) - 1)),
-                                    static_cast<std::int32_t>(key & ((1u << kCellBits) - 1))};
-      // a's side of the rule: on each axis, the cell is a's least one or b's must be.
-      const bool a0 = ca.cellLo[0] == cell[0], a1 = ca.cellLo[1] == cell[1], a2 = ca.cellLo[2] == cell[2];
-      for (std::uint32_t j = i + 1; j < end; ++j) {
-        const Candidate& cb = sorted_[j];
-        const bool sameCell = cb.key == key;  // not another cell in the same bucket
-        const bool rule = (a0 | (cb.cellLo[0] == cell[0])) & (a1 | (cb.cellLo[1] == cell[1])) &
-                          (a2 | (cb.cellLo[2] == cell[2]));
-        if (!(sameCell & rule)) continue;
-        const bool overlap = (cb.lo[0] <= ca.hi[0]) & (cb.hi[0] >= ca.lo[0]) & (cb.lo[1] <= ca.hi[1]) &
-                             (cb.hi[1] >= ca.lo[1]) & (cb.lo[2] <= ca.hi[2]) & (cb.hi[2] >= ca.lo[2]);
-        const std::uint32_t *va = ca.vertex, *vb = cb.vertex;
-        const bool apart = (va[0] != vb[0]) & (va[0] != vb[1]) & (va[0] != vb[2]) & (va[1] != vb[0]) &
-                           (va[1] != vb[1]) & (va[1] != vb[2]) & (va[2] != vb[0]) & (va[2] != vb[1]) &
-                           (va[2] != vb[2]);
-        if (sameCell & rule & overlap & apart &&
-            intervalTest(x.row(va[0]), x.row(va[1]), x.row(va[2]), x.row(vb[0]), x.row(vb[1]), x.row(vb[2])))
-          ++found;
-      }
+    const std::uint64_t key = key_[begin];
+    for (end = begin + 1; end < total && key_[end] == key; ++end) {
+    }
+    std::uint32_t next = end;
+    while (next < total && key_[next] == key + 1) ++next;
+    Run runs[5] = {{0, next}, {0, 0}, {0, 0}, {0, 0}, {0, 0}};
+    for (int r = 0; r < 4; ++r) {
+      const std::uint64_t first = key + rowOffset[r] - 1, last = key + rowOffset[r] + 1;
+      while (from[r] < total && key_[from[r]] < first) ++from[r];
+      to[r] = std::max(to[r], from[r]);
+      while (to[r] < total && key_[to[r]] <= last) ++to[r];
+      runs[r + 1] = {from[r], to[r]};
+    }
+    for (std::uint32_t i = begin; i < end; ++i) {
+      runs[0].begin = i + 1;
+      testAgainst(x, i, runs, 5);
     }
   }
+  int found = found_;
   // Loose triangles against every other (a pair of two loose ones once), without the box test when either
   // is unboxed: the pair (a < b, as a brute-force loop over i < j would call it) through trianglesIntersect,
   // or once its boxes are known to overlap, through the interval test it ends with.

@@ -42,39 +42,46 @@ CAPE_SCENES_API bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Ve
                                         const Vec3& q1, const Vec3& q2);
 
 /// Counts pairs of triangles that share no vertex and intersect: the pairs whose bounding boxes overlap
-/// (closed boxes, as `trianglesIntersect` counts touching) found through a uniform spatial hash, each pair
-/// tested once with the exact test, so the count is the brute-force count over all pairs. Reuses its scratch
-/// between calls (one counter per cape: no allocation once it has seen the cape's size).
+/// (closed boxes, as `trianglesIntersect` counts touching), each tested once with the exact test, so the
+/// count is the brute-force count over all pairs. The pairs are found through a uniform grid of cells at
+/// least as large as the triangles' boxes, each triangle in the one cell of its box's least corner: two
+/// boxes that overlap then lie in the same or in neighbouring cells. The triangles are sorted by cell, so
+/// that a cell's 13 forward neighbours (one of each opposite pair of the 26) lie in five runs of the order,
+/// and each triangle is tested against those runs four at a time. A triangle larger than the cells (or not
+/// finite) is tested against every other. Reuses its scratch between calls (one counter per cape: no
+/// allocation once it has seen the cape's size).
 class CAPE_SCENES_API SelfIntersectionCounter {
  public:
   /// The number of intersecting pairs of the fabric's triangles at `positions` (m, one row per particle).
   int count(const Fabric& fabric, const Points& positions);
 
  private:
-  /// A triangle's bounding box and the range of hash cells it covers (inclusive).
+  /// A triangle's bounding box.
   struct Box {
     float lo[3], hi[3];
-    std::int32_t cellLo[3], cellHi[3];
   };
-  /// A triangle in one of the cells it covers.
-  struct Entry {
-    std::uint64_t key;  ///< the cell
-    std::uint32_t triangle, bucket;
+  /// A run [begin, end) of the cell order.
+  struct Run {
+    std::uint32_t begin, end;
   };
-  /// The same in bucket order, with what the pair loop reads of its triangle.
-  struct Candidate {
-    float lo[3], hi[3];
-    std::int32_t cellLo[3];
-    std::uint32_t vertex[3];
-    std::uint32_t triangle;
-    std::uint64_t key;
-  };
+  /// Sorts the hashed triangles by cell (stable) into the structure of arrays below.
+  void sortByCell(const std::vector<std::uint32_t>& triangles, std::uint64_t largestKey);
+  /// Tests triangle `a` (an index into the cell order) against the triangles of `runs`.
+  void testAgainst(const Points& positions, std::uint32_t a, const Run* runs, int runCount);
+
   std::vector<Box> boxes_;
-  std::vector<Entry> entries_;              ///< in triangle order
-  std::vector<std::uint32_t> bucketStart_;  ///< counting sort of the entries by bucket
-  std::vector<Candidate> sorted_;           ///< the entries bucket by bucket, ascending triangles in each
-  std::vector<std::uint32_t> loose_;   ///< triangles left out of the hash (too many cells, or not finite)
+  std::vector<std::int32_t> cells_;      ///< per triangle: its cell's three indices (hashed ones)
+  std::vector<std::uint64_t> keys_[2];   ///< the hashed triangles' cells, in radix-sort passes
+  std::vector<std::uint32_t> order_[2];  ///< the hashed triangles, in radix-sort passes
+  std::vector<std::uint32_t> histogram_;
+  // The hashed triangles in the cell order, as structure of arrays (padded for four-wide loads): their
+  // boxes, corners, indices and cells.
+  std::vector<float> lo_[3], hi_[3];
+  std::vector<std::uint32_t> vertex_[3], triangle_;
+  std::vector<std::uint64_t> key_;
+  std::vector<std::uint32_t> loose_;   ///< triangles left out of the grid (too large, or not finite)
   std::vector<std::uint8_t> isLoose_;  ///< per triangle: hashed, loose as too large, loose as not finite
+  int found_ = 0;                      ///< intersecting pairs found so far in this count
 };
 
 /// Per-frame values and run summary of every metric, as the demos report them.
