@@ -4,6 +4,8 @@
 // non-finite particles among them.
 #include "SpringSolver.h"
 
+#include "cape/core/Simd.h"
+
 #include "CapeTestFixture.h"
 
 #include <gtest/gtest.h>
@@ -43,6 +45,19 @@ std::vector<FabricPtr> fabrics() {
           makeGrid(33, 17, 0.6f, 1.0f, 0.4f, false, {0, 32}), meshFabric()};
 }
 
+// Every instruction set of the kernels this processor has (Simd.h), each set in turn for `body` and the one
+// in use put back after: the vector paths are checked at every level, four lanes and eight.
+template <class Body>
+void forEachSimdLevel(Body body) {
+  const SimdLevel before = simdLevel();
+  for (const SimdLevel level : {SimdLevel::Portable, SimdLevel::Avx2}) {
+    if (!setSimdLevel(level).ok()) continue;  // no AVX2 on this processor
+    SCOPED_TRACE(simdLevelName(level));
+    body();
+  }
+  ASSERT_TRUE(setSimdLevel(before).ok());
+}
+
 // The particles of block [s, s + 4) as the layout reads them, in lane order (first ends, then second ends).
 bool followsLayout(const SpringSet& set, std::size_t s, SpringLayout layout) {
   const auto f = [&](std::size_t k) { return static_cast<long>(set.first[s + k]); };
@@ -73,7 +88,7 @@ bool followsLayout(const SpringSet& set, std::size_t s, SpringLayout layout) {
   return true;
 }
 
-TEST(SpringRuns, CoverEverySpringOnceInOrderWithEveryBlockInsideOneColourAndItsLayout) {
+TEST(SpringRuns, CoverEverySpringOnceInOrderWithEveryVectorRunInsideOneColourAndItsLayout) {
   for (const FabricPtr& fabric : fabrics()) {
     ASSERT_TRUE(fabric);
     for (int family = 0; family < kSpringFamilyCount; ++family) {
@@ -85,6 +100,12 @@ TEST(SpringRuns, CoverEverySpringOnceInOrderWithEveryBlockInsideOneColourAndItsL
         next = run.end;
         if (run.layout == SpringLayout::Scalar) continue;
         ASSERT_EQ((run.end - run.begin) % 4, 0u);
+        // A vector run lies inside one colour: the eight-wide kernels solve two of its blocks together.
+        const auto colourOf = [&](std::uint32_t spring) {
+          return std::upper_bound(set.colourStart.begin(), set.colourStart.end(), spring) -
+                 set.colourStart.begin();
+        };
+        EXPECT_EQ(colourOf(run.begin), colourOf(run.end - 1)) << "run at " << run.begin << " spans colours";
         for (std::uint32_t s = run.begin; s < run.end; s += 4) {
           // Inside one colour, and so four distinct particles at each end and none shared.
           const auto colour =
@@ -177,107 +198,134 @@ bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
 }
 
 TEST(SpringSolver, WithoutMultipliersOneIterationGivesTheSameBits) {
-  // One iteration per substep starts every multiplier at zero and never reads it again: the kernels without
-  // the multiplier array (lambda null) must move the particles exactly as the kernels with a zeroed one.
-  for (const FabricPtr& fabric : fabrics()) {
-    ASSERT_TRUE(fabric);
-    for (const bool vector : {false, true}) {
-      KernelState with = jittered(*fabric, 11), without = with;
-      for (int substep = 0; substep < 4; ++substep) {
-        std::fill(with.lambda.begin(), with.lambda.end(), 0.0f);
-        solveAll(*fabric, with, vector, true);
-        solveAll(*fabric, without, vector, false);
+  forEachSimdLevel([&] {
+    // One iteration per substep starts every multiplier at zero and never reads it again: the kernels without
+    // the multiplier array (lambda null) must move the particles exactly as the kernels with a zeroed one.
+    for (const FabricPtr& fabric : fabrics()) {
+      ASSERT_TRUE(fabric);
+      for (const bool vector : {false, true}) {
+        KernelState with = jittered(*fabric, 11), without = with;
+        for (int substep = 0; substep < 4; ++substep) {
+          std::fill(with.lambda.begin(), with.lambda.end(), 0.0f);
+          solveAll(*fabric, with, vector, true);
+          solveAll(*fabric, without, vector, false);
+        }
+        EXPECT_TRUE(sameBits(with.x, without.x)) << vector;
+        EXPECT_TRUE(sameBits(with.y, without.y)) << vector;
+        EXPECT_TRUE(sameBits(with.z, without.z)) << vector;
+        EXPECT_TRUE(
+            std::all_of(without.lambda.begin(), without.lambda.end(), [](float l) { return l == 0.0f; }));
       }
-      EXPECT_TRUE(sameBits(with.x, without.x)) << vector;
-      EXPECT_TRUE(sameBits(with.y, without.y)) << vector;
-      EXPECT_TRUE(sameBits(with.z, without.z)) << vector;
-      EXPECT_TRUE(
-          std::all_of(without.lambda.begin(), without.lambda.end(), [](float l) { return l == 0.0f; }));
     }
-  }
+  });
 }
 
 TEST(SpringSolver, VectorRunsGiveTheScalarLoopsBits) {
-  for (const FabricPtr& fabric : fabrics()) {
-    ASSERT_TRUE(fabric);
-    KernelState vector = jittered(*fabric, 7), scalar = vector;
-    for (int iteration = 0; iteration < 5; ++iteration) {
-      solveAll(*fabric, vector, true);
-      solveAll(*fabric, scalar, false);
+  forEachSimdLevel([&] {
+    for (const FabricPtr& fabric : fabrics()) {
+      ASSERT_TRUE(fabric);
+      KernelState vector = jittered(*fabric, 7), scalar = vector;
+      for (int iteration = 0; iteration < 5; ++iteration) {
+        solveAll(*fabric, vector, true);
+        solveAll(*fabric, scalar, false);
+      }
+      EXPECT_TRUE(sameBits(vector.x, scalar.x));
+      EXPECT_TRUE(sameBits(vector.y, scalar.y));
+      EXPECT_TRUE(sameBits(vector.z, scalar.z));
+      EXPECT_TRUE(sameBits(vector.lambda, scalar.lambda));
+      // And the springs did work: the jittered cape moved.
+      const KernelState start = jittered(*fabric, 7);
+      EXPECT_FALSE(sameBits(vector.y, start.y));
     }
-    EXPECT_TRUE(sameBits(vector.x, scalar.x));
-    EXPECT_TRUE(sameBits(vector.y, scalar.y));
-    EXPECT_TRUE(sameBits(vector.z, scalar.z));
-    EXPECT_TRUE(sameBits(vector.lambda, scalar.lambda));
-    // And the springs did work: the jittered cape moved.
-    const KernelState start = jittered(*fabric, 7);
-    EXPECT_FALSE(sameBits(vector.y, start.y));
-  }
+  });
 }
 
 TEST(SpringSolver, ScaledComplianceGivesTheScalarLoopsBitsAndOneChangesNoBit) {
-  // Per-spring compliance scales (Cape::setStiffnessScale): the vector runs still give the scalar loop's
-  // bits, with and without multipliers; a scale of exactly 1 everywhere gives the unscaled kernels' bits;
-  // and a real scale moves the particles elsewhere.
-  for (const FabricPtr& fabric : fabrics()) {
-    ASSERT_TRUE(fabric);
-    std::vector<float> scale(fabric->springCount()), ones(fabric->springCount(), 1.0f);
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<float> u(0.05f, 20.0f);
-    for (float& v : scale) v = u(rng);
-    for (const bool keep : {true, false}) {
-      KernelState vector = jittered(*fabric, 5), scalar = vector, unit = vector, plain = vector;
-      for (int iteration = 0; iteration < 5; ++iteration) {
-        solveAll(*fabric, vector, true, keep, &scale);
-        solveAll(*fabric, scalar, false, keep, &scale);
-        solveAll(*fabric, unit, true, keep, &ones);
-        solveAll(*fabric, plain, true, keep, nullptr);
+  forEachSimdLevel([&] {
+    // Per-spring compliance scales (Cape::setStiffnessScale): the vector runs still give the scalar loop's
+    // bits, with and without multipliers; a scale of exactly 1 everywhere gives the unscaled kernels' bits;
+    // and a real scale moves the particles elsewhere.
+    for (const FabricPtr& fabric : fabrics()) {
+      ASSERT_TRUE(fabric);
+      std::vector<float> scale(fabric->springCount()), ones(fabric->springCount(), 1.0f);
+      std::mt19937 rng(3);
+      std::uniform_real_distribution<float> u(0.05f, 20.0f);
+      for (float& v : scale) v = u(rng);
+      for (const bool keep : {true, false}) {
+        KernelState vector = jittered(*fabric, 5), scalar = vector, unit = vector, plain = vector;
+        for (int iteration = 0; iteration < 5; ++iteration) {
+          solveAll(*fabric, vector, true, keep, &scale);
+          solveAll(*fabric, scalar, false, keep, &scale);
+          solveAll(*fabric, unit, true, keep, &ones);
+          solveAll(*fabric, plain, true, keep, nullptr);
+        }
+        EXPECT_TRUE(sameBits(vector.x, scalar.x) && sameBits(vector.y, scalar.y) &&
+                    sameBits(vector.z, scalar.z));
+        EXPECT_TRUE(sameBits(vector.lambda, scalar.lambda));
+        EXPECT_TRUE(sameBits(unit.x, plain.x) && sameBits(unit.y, plain.y) && sameBits(unit.z, plain.z));
+        EXPECT_FALSE(sameBits(vector.y, plain.y));
       }
-      EXPECT_TRUE(sameBits(vector.x, scalar.x) && sameBits(vector.y, scalar.y) &&
-                  sameBits(vector.z, scalar.z));
-      EXPECT_TRUE(sameBits(vector.lambda, scalar.lambda));
-      EXPECT_TRUE(sameBits(unit.x, plain.x) && sameBits(unit.y, plain.y) && sameBits(unit.z, plain.z));
-      EXPECT_FALSE(sameBits(vector.y, plain.y));
     }
+  });
+}
+
+TEST(SimdLevels, TheWidestIsTheDefaultAndALevelTheProcessorLacksIsRefused) {
+  const SimdLevel before = simdLevel();
+  EXPECT_TRUE(setSimdLevel(SimdLevel::Portable).ok());  // every processor runs the portable kernels
+  EXPECT_EQ(simdLevel(), SimdLevel::Portable);
+  const Status avx2 = setSimdLevel(SimdLevel::Avx2);
+  EXPECT_EQ(avx2.ok(), simdAvailable() == SimdLevel::Avx2);
+  EXPECT_EQ(simdLevel(), avx2.ok() ? SimdLevel::Avx2 : SimdLevel::Portable);  // a refusal keeps the level
+  if (!avx2.ok()) {
+    EXPECT_NE(avx2.message().find("AVX2"), std::string::npos) << avx2.message();
   }
+  const Status bad = setSimdLevel(static_cast<SimdLevel>(7));
+  EXPECT_FALSE(bad.ok());
+  EXPECT_FALSE(bad.message().empty());
+  EXPECT_STREQ(simdLevelName(SimdLevel::Portable), "portable");
+  EXPECT_STREQ(simdLevelName(SimdLevel::Avx2), "avx2");
+  ASSERT_TRUE(setSimdLevel(before).ok());
+  RecordProperty("available", simdLevelName(simdAvailable()));
 }
 
 TEST(Tethers, VectorPathGivesTheScalarLoopsBits) {
-  for (const FabricPtr& fabric : fabrics()) {
-    ASSERT_TRUE(fabric);
-    const TetherSet& tethers = fabric->tethers();
-    ASSERT_GT(tethers.size(), 0u);
-    KernelState vector = jittered(*fabric, 11);
-    // Pin the anchors (one of them left free on the second fabric: its tethers must not act), and stretch
-    // the cape downwards so that the lower half is taut.
-    for (std::uint32_t a : tethers.anchor) vector.w[a] = 0.0f;
-    if (fabric->gridColumns() == 7) vector.w[tethers.anchor.back()] = 1.0f;
-    for (float& y : vector.y) y *= 1.3f;
-    const KernelState before = vector;
-    KernelState scalar = vector;
-    detail::solveTethers(vector.x.data(), vector.y.data(), vector.z.data(), vector.w.data(), tethers);
-    detail::solveTethersScalar(scalar.x.data(), scalar.y.data(), scalar.z.data(), scalar.w.data(), tethers, 0,
-                               tethers.size());
-    EXPECT_TRUE(sameBits(vector.x, scalar.x));
-    EXPECT_TRUE(sameBits(vector.y, scalar.y));
-    EXPECT_TRUE(sameBits(vector.z, scalar.z));
-    // The last tether of every particle holds it within its length of a pinned anchor (an earlier one may be
-    // loosened again by a later one); the taut ones moved their particles.
-    std::vector<std::size_t> last(fabric->particleCount(), tethers.size());
-    for (std::size_t k = 0; k < tethers.size(); ++k) last[tethers.particle[k]] = k;
-    std::size_t moved = 0;
-    for (std::size_t p = 0; p < last.size(); ++p) {
-      if (last[p] == tethers.size() || !std::isfinite(vector.x[p])) continue;
-      moved += vector.y[p] != before.y[p];
-      const std::uint32_t a = tethers.anchor[last[p]];
-      if (vector.w[a] != 0.0f || vector.w[p] == 0.0f) continue;
-      const float d = std::sqrt((vector.x[p] - vector.x[a]) * (vector.x[p] - vector.x[a]) +
-                                (vector.y[p] - vector.y[a]) * (vector.y[p] - vector.y[a]) +
-                                (vector.z[p] - vector.z[a]) * (vector.z[p] - vector.z[a]));
-      EXPECT_LE(d, tethers.maxLength[last[p]] * 1.00001f) << "particle " << p;
+  forEachSimdLevel([&] {
+    for (const FabricPtr& fabric : fabrics()) {
+      ASSERT_TRUE(fabric);
+      const TetherSet& tethers = fabric->tethers();
+      ASSERT_GT(tethers.size(), 0u);
+      KernelState vector = jittered(*fabric, 11);
+      // Pin the anchors (one of them left free on the second fabric: its tethers must not act), and stretch
+      // the cape downwards so that the lower half is taut.
+      for (std::uint32_t a : tethers.anchor) vector.w[a] = 0.0f;
+      if (fabric->gridColumns() == 7) vector.w[tethers.anchor.back()] = 1.0f;
+      for (float& y : vector.y) y *= 1.3f;
+      const KernelState before = vector;
+      KernelState scalar = vector;
+      detail::solveTethers(vector.x.data(), vector.y.data(), vector.z.data(), vector.w.data(), tethers);
+      detail::solveTethersScalar(scalar.x.data(), scalar.y.data(), scalar.z.data(), scalar.w.data(), tethers,
+                                 0, tethers.size());
+      EXPECT_TRUE(sameBits(vector.x, scalar.x));
+      EXPECT_TRUE(sameBits(vector.y, scalar.y));
+      EXPECT_TRUE(sameBits(vector.z, scalar.z));
+      // The last tether of every particle holds it within its length of a pinned anchor (an earlier one may
+      // be loosened again by a later one); the taut ones moved their particles.
+      std::vector<std::size_t> last(fabric->particleCount(), tethers.size());
+      for (std::size_t k = 0; k < tethers.size(); ++k) last[tethers.particle[k]] = k;
+      std::size_t moved = 0;
+      for (std::size_t p = 0; p < last.size(); ++p) {
+        if (last[p] == tethers.size() || !std::isfinite(vector.x[p])) continue;
+        moved += vector.y[p] != before.y[p];
+        const std::uint32_t a = tethers.anchor[last[p]];
+        if (vector.w[a] != 0.0f || vector.w[p] == 0.0f) continue;
+        const float d = std::sqrt((vector.x[p] - vector.x[a]) * (vector.x[p] - vector.x[a]) +
+                                  (vector.y[p] - vector.y[a]) * (vector.y[p] - vector.y[a]) +
+                                  (vector.z[p] - vector.z[a]) * (vector.z[p] - vector.z[a]));
+        EXPECT_LE(d, tethers.maxLength[last[p]] * 1.00001f) << "particle " << p;
+      }
+      EXPECT_GT(moved, 0u);
     }
-    EXPECT_GT(moved, 0u);
-  }
+  });
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // Stored determinism hashes of the canonical scenes on the simple body: a refactor of the solver must keep
 // every bit of them. A change of behaviour on purpose updates the table in the same commit and says why in
 // its message. (Hashes are of this toolchain's IEEE single-precision arithmetic with -ffp-contract=off: the
-// same on every x86-64 build of the core, Release or Debug.)
+// same on every x86-64 build of the core, Release or Debug, and at every instruction set of the kernels.)
+#include "cape/core/Simd.h"
 #include "cape/scenes/Scene.h"
 
 #include <gtest/gtest.h>
@@ -41,11 +42,18 @@ std::uint64_t runScene(SceneKind kind, bool selfCollision) {
 }
 
 TEST(StoredHashes, EveryCanonicalSceneKeepsItsBits) {
-  for (const StoredScene& s : kStored) {
-    const std::uint64_t h = runScene(s.kind, s.selfCollision);
-    EXPECT_EQ(h, s.hash) << toString(s.kind) << (s.selfCollision ? " with" : " without")
-                         << " self-collision: 0x" << std::hex << h;
+  // With the portable kernels, and with the eight-wide ones where this processor has them (Simd.h): the
+  // same table, since every level gives the same bits.
+  const SimdLevel before = simdLevel();
+  for (const SimdLevel level : {SimdLevel::Portable, SimdLevel::Avx2}) {
+    if (!setSimdLevel(level).ok()) continue;
+    for (const StoredScene& s : kStored) {
+      const std::uint64_t h = runScene(s.kind, s.selfCollision);
+      EXPECT_EQ(h, s.hash) << toString(s.kind) << (s.selfCollision ? " with" : " without")
+                           << " self-collision, " << simdLevelName(level) << " kernels: 0x" << std::hex << h;
+    }
   }
+  ASSERT_TRUE(setSimdLevel(before).ok());
 }
 
 }  // namespace

@@ -160,11 +160,17 @@ SpringLayout blockLayout(const SpringSet& set, std::size_t s) {
 
 // Cuts each colour into blocks of four (each with its vector layout) and a scalar tail of up to three. Blocks
 // never straddle two colours (the four springs of a block must share no particle); consecutive blocks of one
-// layout, and consecutive scalar springs, share a run, since a run is solved block after block in order.
+// layout and colour, and consecutive scalar springs, share a run, since a run is solved block after block in
+// order. A vector run stays inside one colour, so that any of its blocks share no particle and may be solved
+// together (the eight-wide kernels take two at a time).
 void planRuns(SpringSet& set) {
   set.runs.clear();
-  const auto add = [&](std::size_t begin, std::size_t end, SpringLayout layout) {
-    if (!set.runs.empty() && set.runs.back().end == begin && set.runs.back().layout == layout) {
+  std::size_t lastColour = 0;
+  const auto add = [&](std::size_t begin, std::size_t end, SpringLayout layout, std::size_t colour) {
+    const bool joins = !set.runs.empty() && set.runs.back().end == begin && set.runs.back().layout == layout &&
+                       (layout == SpringLayout::Scalar || colour == lastColour);
+    lastColour = colour;
+    if (joins) {
       set.runs.back().end = static_cast<std::uint32_t>(end);
     } else {
       set.runs.push_back({static_cast<std::uint32_t>(begin), static_cast<std::uint32_t>(end), layout});
@@ -176,7 +182,7 @@ void planRuns(SpringSet& set) {
     while (s < end) {
       const SpringLayout layout = s + 4 > end ? SpringLayout::Scalar : blockLayout(set, s);
       const std::size_t next = layout == SpringLayout::Scalar ? s + 1 : s + 4;
-      add(s, next, layout);
+      add(s, next, layout, c);
       s = next;
     }
   }

@@ -1,11 +1,16 @@
 #include "SpringSolver.h"
 
+#include "SimdDispatch.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if CAPE_HAVE_AVX2_KERNELS
+#include <immintrin.h>
 #endif
 
 namespace cape::detail {
@@ -230,8 +235,118 @@ void solveBlocks(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t 
   }
 }
 
+#if CAPE_HAVE_AVX2_KERNELS
+
+#define CAPE_AVX2 __attribute__((target("avx2")))
+
+// solveBlocks two blocks at a time: eight lanes, each doing its four-lane kernel's operations in the same
+// order (and so the same bits; no fused multiply-add). The two blocks of a run share no particle (a vector
+// run lies inside one colour), so loading the second before the first is stored changes nothing. An odd last
+// block goes through solveBlocks.
+CAPE_AVX2 inline __m256 join(__m128 low, __m128 high) {
+  return _mm256_insertf128_ps(_mm256_castps128_ps256(low), high, 1);
+}
+
+template <SpringLayout L>
+CAPE_AVX2 inline void load8(const float* x, const std::uint32_t* i, const std::uint32_t* j, __m256& vi,
+                            __m256& vj) {
+  __m128 i0, j0, i1, j1;
+  Lanes<L>::load(x, i, j, i0, j0);
+  Lanes<L>::load(x, i + 4, j + 4, i1, j1);
+  vi = join(i0, i1);
+  vj = join(j0, j1);
+}
+
+template <SpringLayout L>
+CAPE_AVX2 inline void store8(float* x, const std::uint32_t* i, const std::uint32_t* j, __m256 vi, __m256 vj) {
+  Lanes<L>::store(x, i, j, _mm256_castps256_ps128(vi), _mm256_castps256_ps128(vj));
+  Lanes<L>::store(x, i + 4, j + 4, _mm256_extractf128_ps(vi, 1), _mm256_extractf128_ps(vj, 1));
+}
+
+CAPE_AVX2 inline __m256 select8(__m256 mask, __m256 ifTrue, __m256 ifFalse) {
+  return _mm256_blendv_ps(ifFalse, ifTrue, mask);  // the masks are whole lanes, as select's
+}
+
+template <SpringLayout L, bool kLambda, bool kScaled>
+CAPE_AVX2 void solveBlocks8(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end,
+                            float alphaTilde) {
+  const __m256 alphaBase = _mm256_set1_ps(alphaTilde);
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+  const __m256 minLen2 = _mm256_set1_ps(1e-18f);
+  const __m256 maxLen2 = _mm256_set1_ps(kMaxLength2);
+  std::uint32_t s = begin;
+  for (; s + 8 <= end; s += 8) {
+    const std::uint32_t* p = a.first + s;
+    const std::uint32_t* q = a.second + s;
+    __m256 alpha = alphaBase;
+    if constexpr (kScaled) alpha = _mm256_mul_ps(alphaBase, _mm256_loadu_ps(a.complianceScale + s));
+    __m256 xi, xj, yi, yj, zi, zj, wi, wj;
+    load8<L>(a.px, p, q, xi, xj);
+    load8<L>(a.py, p, q, yi, yj);
+    load8<L>(a.pz, p, q, zi, zj);
+    load8<L>(a.inverseMass, p, q, wi, wj);
+    const __m256 dx = _mm256_sub_ps(xj, xi), dy = _mm256_sub_ps(yj, yi), dz = _mm256_sub_ps(zj, zi);
+    const __m256 len2 =
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
+    const __m256 active =
+        _mm256_and_ps(_mm256_cmp_ps(len2, minLen2, _CMP_GT_OS), _mm256_cmp_ps(len2, maxLen2, _CMP_LE_OS));
+    const __m256 wsum = _mm256_add_ps(wi, wj);
+    const __m256 invDenominator =
+        _mm256_and_ps(_mm256_cmp_ps(wsum, zero, _CMP_GT_OS), _mm256_div_ps(one, _mm256_add_ps(wsum, alpha)));
+    const __m256 len = _mm256_sqrt_ps(len2);
+    __m256 dl;
+    if constexpr (kLambda) {
+      const __m256 lambda = _mm256_loadu_ps(a.lambda + s);
+      dl = _mm256_mul_ps(
+          _mm256_sub_ps(_mm256_sub_ps(_mm256_loadu_ps(a.restLength + s), len), _mm256_mul_ps(alpha, lambda)),
+          invDenominator);
+      _mm256_storeu_ps(a.lambda + s, select8(active, _mm256_add_ps(lambda, dl), lambda));
+    } else {
+      dl = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(a.restLength + s), len), invDenominator);
+    }
+    const __m256 k = _mm256_div_ps(dl, len);
+    const __m256 cx = _mm256_mul_ps(k, dx), cy = _mm256_mul_ps(k, dy), cz = _mm256_mul_ps(k, dz);
+    store8<L>(a.px, p, q, select8(active, _mm256_sub_ps(xi, _mm256_mul_ps(wi, cx)), xi),
+              select8(active, _mm256_add_ps(xj, _mm256_mul_ps(wj, cx)), xj));
+    store8<L>(a.py, p, q, select8(active, _mm256_sub_ps(yi, _mm256_mul_ps(wi, cy)), yi),
+              select8(active, _mm256_add_ps(yj, _mm256_mul_ps(wj, cy)), yj));
+    store8<L>(a.pz, p, q, select8(active, _mm256_sub_ps(zi, _mm256_mul_ps(wi, cz)), zi),
+              select8(active, _mm256_add_ps(zj, _mm256_mul_ps(wj, cz)), zj));
+  }
+  if (s < end) solveBlocks<L, kLambda, kScaled>(a, s, end, alphaTilde);
+}
+
+template <bool kLambda, bool kScaled>
+CAPE_AVX2 bool solveRun8(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
+  switch (run.layout) {
+    case SpringLayout::Contiguous:
+      solveBlocks8<SpringLayout::Contiguous, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
+      return true;
+    case SpringLayout::PairSwapped:
+      solveBlocks8<SpringLayout::PairSwapped, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
+      return true;
+    case SpringLayout::Interleaved:
+      solveBlocks8<SpringLayout::Interleaved, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
+      return true;
+    case SpringLayout::Pairs:
+      solveBlocks8<SpringLayout::Pairs, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
+      return true;
+    case SpringLayout::Gathered:
+      solveBlocks8<SpringLayout::Gathered, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
+      return true;
+    case SpringLayout::Scalar:
+      break;
+  }
+  return false;
+}
+
+#endif  // CAPE_HAVE_AVX2_KERNELS
+
 template <bool kLambda, bool kScaled>
 void solveRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
+#if CAPE_HAVE_AVX2_KERNELS
+  if (useAvx2Kernels() && solveRun8<kLambda, kScaled>(a, run, alphaTilde)) return;
+#endif
   switch (run.layout) {
     case SpringLayout::Contiguous:
       return solveBlocks<SpringLayout::Contiguous, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
@@ -251,38 +366,94 @@ void solveRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde
 
 }  // namespace
 
+namespace {
+
+// Whether tethers [k, k + count) move the consecutive particles particle[k], particle[k] + 1, ...
+bool consecutive(const std::uint32_t* particle, std::size_t k, std::size_t count, std::size_t n) {
+  if (k + count > n) return false;
+  for (std::size_t i = 1; i < count; ++i)
+    if (particle[k + i] != particle[k] + i) return false;
+  return true;
+}
+
+// solveTethersScalar's body for the four tethers from k, which move consecutive particles.
+inline void tetherBlock(float* px, float* py, float* pz, const float* w, const TetherSet& tethers,
+                        std::size_t k) {
+  const std::uint32_t p = tethers.particle[k];
+  const std::uint32_t* anchor = tethers.anchor.data() + k;
+  const __m128 zero = _mm_setzero_ps(), tiny = _mm_set1_ps(1e-30f);
+  const auto gather = [anchor](const float* x) {
+    return _mm_setr_ps(x[anchor[0]], x[anchor[1]], x[anchor[2]], x[anchor[3]]);
+  };
+  const __m128 xp = _mm_loadu_ps(px + p), yp = _mm_loadu_ps(py + p), zp = _mm_loadu_ps(pz + p);
+  const __m128 xa = gather(px), ya = gather(py), za = gather(pz);
+  const __m128 dx = _mm_sub_ps(xp, xa), dy = _mm_sub_ps(yp, ya), dz = _mm_sub_ps(zp, za);
+  const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+  const __m128 maxLen = _mm_loadu_ps(tethers.maxLength.data() + k);
+  const __m128 taut =
+      _mm_and_ps(_mm_and_ps(_mm_cmpeq_ps(gather(w), zero), _mm_cmpneq_ps(_mm_loadu_ps(w + p), zero)),
+                 _mm_cmpgt_ps(len2, _mm_mul_ps(maxLen, maxLen)));
+  // max(tiny, len2) is len2 when len2 is NaN, as std::max(len2, tiny) is.
+  const __m128 scale = _mm_div_ps(maxLen, _mm_sqrt_ps(_mm_max_ps(tiny, len2)));
+  _mm_storeu_ps(px + p, select(taut, _mm_add_ps(xa, _mm_mul_ps(dx, scale)), xp));
+  _mm_storeu_ps(py + p, select(taut, _mm_add_ps(ya, _mm_mul_ps(dy, scale)), yp));
+  _mm_storeu_ps(pz + p, select(taut, _mm_add_ps(za, _mm_mul_ps(dz, scale)), zp));
+}
+
+#if CAPE_HAVE_AVX2_KERNELS
+
+CAPE_AVX2 inline __m256 gather8(const float* x, const std::uint32_t* index) {
+  return _mm256_setr_ps(x[index[0]], x[index[1]], x[index[2]], x[index[3]], x[index[4]], x[index[5]],
+                        x[index[6]], x[index[7]]);
+}
+
+// tetherBlock for the eight tethers from k (consecutive particles), lane for lane the same operations.
+CAPE_AVX2 void tetherBlock8(float* px, float* py, float* pz, const float* w, const TetherSet& tethers,
+                            std::size_t k) {
+  const std::uint32_t p = tethers.particle[k];
+  const std::uint32_t* anchor = tethers.anchor.data() + k;
+  const __m256 zero = _mm256_setzero_ps(), tiny = _mm256_set1_ps(1e-30f);
+  const __m256 xp = _mm256_loadu_ps(px + p), yp = _mm256_loadu_ps(py + p), zp = _mm256_loadu_ps(pz + p);
+  const __m256 xa = gather8(px, anchor), ya = gather8(py, anchor), za = gather8(pz, anchor);
+  const __m256 dx = _mm256_sub_ps(xp, xa), dy = _mm256_sub_ps(yp, ya), dz = _mm256_sub_ps(zp, za);
+  const __m256 len2 =
+      _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
+  const __m256 maxLen = _mm256_loadu_ps(tethers.maxLength.data() + k);
+  const __m256 taut = _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(gather8(w, anchor), zero, _CMP_EQ_OQ),
+                                                  _mm256_cmp_ps(_mm256_loadu_ps(w + p), zero, _CMP_NEQ_UQ)),
+                                    _mm256_cmp_ps(len2, _mm256_mul_ps(maxLen, maxLen), _CMP_GT_OS));
+  const __m256 scale = _mm256_div_ps(maxLen, _mm256_sqrt_ps(_mm256_max_ps(tiny, len2)));
+  _mm256_storeu_ps(px + p, select8(taut, _mm256_add_ps(xa, _mm256_mul_ps(dx, scale)), xp));
+  _mm256_storeu_ps(py + p, select8(taut, _mm256_add_ps(ya, _mm256_mul_ps(dy, scale)), yp));
+  _mm256_storeu_ps(pz + p, select8(taut, _mm256_add_ps(za, _mm256_mul_ps(dz, scale)), zp));
+}
+
+#endif  // CAPE_HAVE_AVX2_KERNELS
+
+}  // namespace
+
 void solveTethers(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers) {
   const std::uint32_t* particle = tethers.particle.data();
-  const std::uint32_t* anchor = tethers.anchor.data();
-  const float* maxLength = tethers.maxLength.data();
-  const float* w = inverseMass;
-  const __m128 zero = _mm_setzero_ps(), tiny = _mm_set1_ps(1e-30f);
-  const auto gather = [](const float* x, const std::uint32_t* index) {
-    return _mm_setr_ps(x[index[0]], x[index[1]], x[index[2]], x[index[3]]);
-  };
-  std::size_t k = 0;
   const std::size_t n = tethers.size();
+#if CAPE_HAVE_AVX2_KERNELS
+  const bool wide = useAvx2Kernels();
+#endif
+  std::size_t k = 0;
   while (k < n) {
-    const std::uint32_t p = particle[k];
-    if (k + 4 > n || particle[k + 1] != p + 1 || particle[k + 2] != p + 2 || particle[k + 3] != p + 3) {
-      solveTethersScalar(px, py, pz, inverseMass, tethers, k, k + 1);
-      ++k;
+#if CAPE_HAVE_AVX2_KERNELS
+    if (wide && consecutive(particle, k, 8, n)) {
+      tetherBlock8(px, py, pz, inverseMass, tethers, k);
+      k += 8;
       continue;
     }
-    const __m128 xp = _mm_loadu_ps(px + p), yp = _mm_loadu_ps(py + p), zp = _mm_loadu_ps(pz + p);
-    const __m128 xa = gather(px, anchor + k), ya = gather(py, anchor + k), za = gather(pz, anchor + k);
-    const __m128 dx = _mm_sub_ps(xp, xa), dy = _mm_sub_ps(yp, ya), dz = _mm_sub_ps(zp, za);
-    const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-    const __m128 maxLen = _mm_loadu_ps(maxLength + k);
-    const __m128 taut = _mm_and_ps(
-        _mm_and_ps(_mm_cmpeq_ps(gather(w, anchor + k), zero), _mm_cmpneq_ps(_mm_loadu_ps(w + p), zero)),
-        _mm_cmpgt_ps(len2, _mm_mul_ps(maxLen, maxLen)));
-    // max(tiny, len2) is len2 when len2 is NaN, as std::max(len2, tiny) is.
-    const __m128 scale = _mm_div_ps(maxLen, _mm_sqrt_ps(_mm_max_ps(tiny, len2)));
-    _mm_storeu_ps(px + p, select(taut, _mm_add_ps(xa, _mm_mul_ps(dx, scale)), xp));
-    _mm_storeu_ps(py + p, select(taut, _mm_add_ps(ya, _mm_mul_ps(dy, scale)), yp));
-    _mm_storeu_ps(pz + p, select(taut, _mm_add_ps(za, _mm_mul_ps(dz, scale)), zp));
-    k += 4;
+#endif
+    if (consecutive(particle, k, 4, n)) {
+      tetherBlock(px, py, pz, inverseMass, tethers, k);
+      k += 4;
+      continue;
+    }
+    solveTethersScalar(px, py, pz, inverseMass, tethers, k, k + 1);
+    ++k;
   }
 }
 

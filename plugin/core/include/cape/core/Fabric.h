@@ -54,7 +54,8 @@ struct SpringSet {
   std::vector<std::uint32_t> second;       ///< Particle index of the other end.
   std::vector<float> restLength;           ///< |x_first - x_second| at rest, m (> 0).
   std::vector<std::uint32_t> colourStart;  ///< Offsets of each colour, plus the end.
-  /// The set cut into runs, in order (built with the colouring); no block of four straddles two colours.
+  /// The set cut into runs, in order (built with the colouring); no block of four straddles two colours, and
+  /// no vector run does either (any two blocks of one run share no particle).
   /// Solving the runs in order is solving the springs in order: the four springs of a block share no
   /// particle, so solving them together gives the same bits as one after another.
   std::vector<SpringRun> runs;
