@@ -167,7 +167,8 @@ void planRuns(SpringSet& set) {
   set.runs.clear();
   std::size_t lastColour = 0;
   const auto add = [&](std::size_t begin, std::size_t end, SpringLayout layout, std::size_t colour) {
-    const bool joins = !set.runs.empty() && set.runs.back().end == begin && set.runs.back().layout == layout &&
+    const bool joins = !set.runs.empty() && set.runs.back().end == begin &&
+                       set.runs.back().layout == layout &&
                        (layout == SpringLayout::Scalar || colour == lastColour);
     lastColour = colour;
     if (joins) {

@@ -10,6 +10,9 @@ namespace {
 
 bool cpuHasAvx2() {
 #if CAPE_HAVE_AVX2_KERNELS
+  // The compiler's CPU model: AVX2 only where the processor has it and the operating system saves its
+  // registers (XCR0), so the eight-wide kernels never fault.
+  __builtin_cpu_init();
   return __builtin_cpu_supports("avx2");
 #else
   return false;
