@@ -10,6 +10,8 @@
 #include "SceneOptions.h"
 #include "SceneRun.h"
 
+#include "cape/core/Simd.h"
+
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -114,6 +116,12 @@ int main(int argc, char** argv) {
          "m behind the last row of characters, at the middle of the rows, 1.6 m up)")
       ->check(strictVector3(kMaxOrigin))
       ->needs(lodOption);
+  std::string simd = simdLevelName(simdAvailable());
+  app.add_option("--simd", simd,
+                 "the solver kernels' instruction set: portable | avx2 (default: the widest this processor "
+                 "has; every one gives the same bits, cape/core/Simd.h)")
+      ->check(CLI::IsMember({"portable", "avx2"}))
+      ->capture_default_str();
   app.add_option("--threads", threads, "worker threads stepping the capes")
       ->transform(strictInteger(1, 256))
       ->capture_default_str();
@@ -152,6 +160,11 @@ int main(int argc, char** argv) {
   std::string optionError;
   if (!toRunOptions(sceneCli, o, optionError)) {
     std::fprintf(stderr, "cape_walk: %s\n", optionError.c_str());
+    return 1;
+  }
+  if (const Status chosen = setSimdLevel(simd == "avx2" ? SimdLevel::Avx2 : SimdLevel::Portable);
+      !chosen.ok()) {
+    std::fprintf(stderr, "cape_walk: --simd %s: %s\n", simd.c_str(), chosen.message().c_str());
     return 1;
   }
   o.threads = threads;
@@ -403,6 +416,7 @@ int main(int argc, char** argv) {
   summary["attachment"] = attachment;
   summary["characters"] = run->characterCount();
   summary["threads"] = threads;
+  summary["simd"] = simdLevelName(simdLevel());
   const Fabric& fabric = run->cape(0).fabric();
   summary["grid"] = {{"columns", fabric.gridColumns()},
                      {"rows", fabric.gridRows()},

@@ -4,6 +4,8 @@
 // refused like any other bad number.
 #include "DemoTestSupport.h"
 
+#include "cape/core/Simd.h"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -212,6 +214,28 @@ TEST(Crowd, APrepareOnTheWorkersGivesTheSameCapes) {
   EXPECT_EQ(hashes[0].size(), 9u);
   EXPECT_EQ(hashes[1], hashes[0]);
   EXPECT_EQ(hashes[2], hashes[0]);
+}
+
+TEST(Crowd, EveryInstructionSetGivesTheSameCapes) {
+  // cape_walk --simd: the portable kernels and, where this processor has them, the AVX2 ones give every cape
+  // of a crowd the same bits (cape/core/Simd.h), and summary.json says which ran.
+  const std::string crowd = kWalk + " --simple-body --scene crowd --characters 4 --size 12 --seconds 0.5 " +
+                            "--no-render --no-frames --self-collision";
+  std::vector<json> hashes;
+  for (const SimdLevel level : {SimdLevel::Portable, SimdLevel::Avx2}) {
+    if (level == SimdLevel::Avx2 && simdAvailable() != SimdLevel::Avx2) continue;
+    const fs::path dir = freshDir() / "run";
+    const Result r = run(crowd + " --simd " + simdLevelName(level) + " --out " + dir.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const json s = summaryOf(dir);
+    EXPECT_EQ(s["simd"], simdLevelName(level));
+    hashes.push_back(s["state_hashes"]);
+  }
+  for (const json& h : hashes) EXPECT_EQ(h, hashes.front());
+  EXPECT_EQ(hashes.front().size(), 4u);
+  const Result bad = run(kWalk + " --simple-body --seconds 0.1 --no-render --simd sse9");
+  EXPECT_GE(bad.exitCode, 100) << bad.output;
+  EXPECT_NE(bad.output.find("--simd"), std::string::npos) << bad.output;
 }
 
 TEST(Crowd, BadLevelsOfDetailAreRefused) {
