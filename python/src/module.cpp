@@ -5,6 +5,7 @@
 #include "PyWorld.h"
 
 #include "cape/core/FabricPresets.h"
+#include "cape/core/Simd.h"
 
 #include <pybind11/stl.h>
 
@@ -633,6 +634,25 @@ PYBIND11_MODULE(capecloth, m) {
       "name"_a,
       "A preset's material per area: areal_density kg/m^2, stretch and shear stiffness N/m, bending_rigidity "
       "N m, bending_length m, damping 1/s, drag and lift coefficients, and its sources.");
+  m.def(
+      "simd_level", [] { return std::string(cape::simdLevelName(cape::simdLevel())); },
+      "The instruction set of the solver's kernels now: \"portable\" or \"avx2\" (cape/core/Simd.h).");
+  m.def(
+      "simd_available", [] { return std::string(cape::simdLevelName(cape::simdAvailable())); },
+      "The widest instruction set of the solver's kernels this processor runs: \"portable\" or \"avx2\".");
+  m.def(
+      "set_simd_level",
+      [](const std::string& name) {
+        if (name != "portable" && name != "avx2")
+          throw std::invalid_argument("set_simd_level: \"portable\" or \"avx2\", not \"" + name + "\"");
+        const cape::Status s =
+            cape::setSimdLevel(name == "avx2" ? cape::SimdLevel::Avx2 : cape::SimdLevel::Portable);
+        if (!s.ok()) throw std::invalid_argument(s.message());
+      },
+      "name"_a,
+      "Chooses the instruction set of the solver's kernels for the whole process (\"portable\" forces the "
+      "portable ones); every one gives the same bits. ValueError for a name that is neither, or \"avx2\" on "
+      "a processor without it.");
   capepy::bindHandles(m);
   capepy::bindWorld(m);
 }
