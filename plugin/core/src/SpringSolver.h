@@ -38,9 +38,10 @@ struct SpringSolveArrays {
 void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::uint32_t end, float alphaTilde);
 
 /// The same over a run, four springs at a time with vector loads and stores where the run's layout allows
-/// (SSE2 on x86-64; elsewhere one at a time). Bit for bit the result of solveSpringsScalar over the run:
-/// the four springs of a block share no particle and every lane does the scalar loop's operations in its
-/// order (the core is built without floating-point contraction).
+/// (SSE2 on x86-64; elsewhere one at a time), or eight (two blocks of the run) with the AVX2 kernels
+/// (cape/core/Simd.h). Bit for bit the result of solveSpringsScalar over the run: the springs of a run's
+/// blocks share no particle and every lane does the scalar loop's operations in its order (the core is
+/// built without floating-point contraction, and the AVX2 kernels use no fused multiply-add).
 void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde);
 
 /// Unilateral tethers |x_p - x_a| <= maxLength while the anchor a is pinned (w_a = 0): a taut tether moves p
@@ -48,9 +49,10 @@ void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alph
 void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers,
                         std::size_t begin, std::size_t end);
 
-/// The same over all tethers, four at a time where four consecutive tethers move consecutive particles (the
-/// fabric lists every particle's nearest anchor, then every particle's second nearest...). Bit for bit the
-/// scalar loop: anchors are never tethered particles, so the four read nothing the others write.
+/// The same over all tethers, four (eight with the AVX2 kernels) at a time where as many consecutive tethers
+/// move consecutive particles (the fabric lists every particle's nearest anchor, then every particle's second
+/// nearest...). Bit for bit the scalar loop: anchors are never tethered particles, so the tethers of a block
+/// read nothing the others write.
 void solveTethers(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers);
 
 /// The linear bending hinges (Fabric.h's HingeSet) as XPBD constraints C = |d| - restBend, with d the
