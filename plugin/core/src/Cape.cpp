@@ -661,17 +661,10 @@ void Cape::adaptRefinement() {
     refinement_ = 1;
     return;
   }
-  const SpringSet& set = fabric_->springs(SpringFamily::Structural);
-  const float* px = state_.positions.col(0).data();
-  const float* py = state_.positions.col(1).data();
-  const float* pz = state_.positions.col(2).data();
-  float worst = 0.0f;  // max over springs of |x_i - x_j|^2 / L0^2
-  for (std::size_t s = 0; s < set.size(); ++s) {
-    const std::uint32_t i = set.first[s], j = set.second[s];
-    const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
-    const float rest = set.restLength[s];
-    worst = std::max(worst, (dx * dx + dy * dy + dz * dz) / (rest * rest));
-  }
+  // max over the structural springs of |x_i - x_j|^2 / L0^2
+  const float worst =
+      detail::maxSquaredStretch(state_.positions.col(0).data(), state_.positions.col(1).data(),
+                                state_.positions.col(2).data(), fabric_->springs(SpringFamily::Structural));
   lastMaxStrain_ = std::sqrt(worst) - 1.0f;
   if (lastMaxStrain_ > settings_.strainLimit)
     refinement_ = std::min(2 * refinement_, maxRefinement);

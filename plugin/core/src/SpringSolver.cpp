@@ -95,6 +95,17 @@ void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMas
   }
 }
 
+float maxSquaredStretchScalar(const float* px, const float* py, const float* pz, const SpringSet& set,
+                              std::size_t begin, std::size_t end, float worst) {
+  for (std::size_t s = begin; s < end; ++s) {
+    const std::uint32_t i = set.first[s], j = set.second[s];
+    const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
+    const float rest = set.restLength[s];
+    worst = std::max(worst, (dx * dx + dy * dy + dz * dz) / (rest * rest));
+  }
+  return worst;
+}
+
 #if defined(__SSE2__)
 
 namespace {
@@ -457,6 +468,62 @@ void solveTethers(float* px, float* py, float* pz, const float* inverseMass, con
   }
 }
 
+namespace {
+
+// maxSquaredStretch over one vector run: four lanes of maxima (maxps(v, worst) keeps worst where v is NaN,
+// as std::max(worst, v) does).
+template <SpringLayout L>
+__m128 stretchBlocks(const float* px, const float* py, const float* pz, const SpringSet& set,
+                     const SpringRun& run, __m128 worst) {
+  using In = Lanes<L>;
+  for (std::uint32_t s = run.begin; s < run.end; s += 4) {
+    const std::uint32_t* p = set.first.data() + s;
+    const std::uint32_t* q = set.second.data() + s;
+    __m128 xi, xj, yi, yj, zi, zj;
+    In::load(px, p, q, xi, xj);
+    In::load(py, p, q, yi, yj);
+    In::load(pz, p, q, zi, zj);
+    const __m128 dx = _mm_sub_ps(xj, xi), dy = _mm_sub_ps(yj, yi), dz = _mm_sub_ps(zj, zi);
+    const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 rest = _mm_loadu_ps(set.restLength.data() + s);
+    worst = _mm_max_ps(_mm_div_ps(len2, _mm_mul_ps(rest, rest)), worst);
+  }
+  return worst;
+}
+
+}  // namespace
+
+float maxSquaredStretch(const float* px, const float* py, const float* pz, const SpringSet& set) {
+  __m128 lanes = _mm_setzero_ps();
+  float worst = 0.0f;
+  for (const SpringRun& run : set.runs) {
+    switch (run.layout) {
+      case SpringLayout::Contiguous:
+        lanes = stretchBlocks<SpringLayout::Contiguous>(px, py, pz, set, run, lanes);
+        break;
+      case SpringLayout::PairSwapped:
+        lanes = stretchBlocks<SpringLayout::PairSwapped>(px, py, pz, set, run, lanes);
+        break;
+      case SpringLayout::Interleaved:
+        lanes = stretchBlocks<SpringLayout::Interleaved>(px, py, pz, set, run, lanes);
+        break;
+      case SpringLayout::Pairs:
+        lanes = stretchBlocks<SpringLayout::Pairs>(px, py, pz, set, run, lanes);
+        break;
+      case SpringLayout::Gathered:
+        lanes = stretchBlocks<SpringLayout::Gathered>(px, py, pz, set, run, lanes);
+        break;
+      case SpringLayout::Scalar:
+        worst = maxSquaredStretchScalar(px, py, pz, set, run.begin, run.end, worst);
+        break;
+    }
+  }
+  alignas(16) float l[4];
+  _mm_store_ps(l, lanes);
+  for (const float v : l) worst = std::max(worst, v);  // lanes hold no NaN: maxps kept the old value
+  return worst;
+}
+
 void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
   if (a.complianceScale != nullptr) {
     if (a.lambda != nullptr)
@@ -474,6 +541,10 @@ void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alph
 
 void solveTethers(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers) {
   solveTethersScalar(px, py, pz, inverseMass, tethers, 0, tethers.size());
+}
+
+float maxSquaredStretch(const float* px, const float* py, const float* pz, const SpringSet& set) {
+  return maxSquaredStretchScalar(px, py, pz, set, 0, set.size());
 }
 
 void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {

@@ -44,6 +44,16 @@ void solveSpringsScalar(const SpringSolveArrays& a, std::uint32_t begin, std::ui
 /// built without floating-point contraction, and the AVX2 kernels use no fused multiply-add).
 void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde);
 
+/// The largest squared stretch of a set's springs, max over springs of |x_j - x_i|^2 / L^2 (0 for an empty
+/// set; a spring whose value is NaN is passed over, as std::max(worst, value) passes it over), read run by
+/// run with the solver's vector loads. The same value as the scalar loop: every lane divides as it does, and
+/// a maximum does not depend on the order it is taken in.
+float maxSquaredStretch(const float* px, const float* py, const float* pz, const SpringSet& set);
+
+/// The scalar loop of maxSquaredStretch over springs [begin, end), from `worst`.
+float maxSquaredStretchScalar(const float* px, const float* py, const float* pz, const SpringSet& set,
+                              std::size_t begin, std::size_t end, float worst = 0.0f);
+
 /// Unilateral tethers |x_p - x_a| <= maxLength while the anchor a is pinned (w_a = 0): a taut tether moves p
 /// straight towards a, onto the sphere of radius maxLength. One tether after another.
 void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers,
