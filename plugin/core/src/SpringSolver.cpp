@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -199,6 +200,32 @@ inline __m128 select(__m128 mask, __m128 ifTrue, __m128 ifFalse) {
   return _mm_or_ps(_mm_and_ps(mask, ifTrue), _mm_andnot_ps(mask, ifFalse));
 }
 
+// Calls f(std::integral_constant<SpringLayout, L>()) with a vector layout L as a compile-time constant, and
+// returns true; false, calling nothing, for SpringLayout::Scalar.
+template <class F>
+bool withVectorLayout(SpringLayout layout, F&& f) {
+  switch (layout) {
+    case SpringLayout::Contiguous:
+      f(std::integral_constant<SpringLayout, SpringLayout::Contiguous>());
+      return true;
+    case SpringLayout::PairSwapped:
+      f(std::integral_constant<SpringLayout, SpringLayout::PairSwapped>());
+      return true;
+    case SpringLayout::Interleaved:
+      f(std::integral_constant<SpringLayout, SpringLayout::Interleaved>());
+      return true;
+    case SpringLayout::Pairs:
+      f(std::integral_constant<SpringLayout, SpringLayout::Pairs>());
+      return true;
+    case SpringLayout::Gathered:
+      f(std::integral_constant<SpringLayout, SpringLayout::Gathered>());
+      return true;
+    case SpringLayout::Scalar:
+      break;
+  }
+  return false;
+}
+
 // solveSpringsScalar's body in four lanes. A lane whose spring has no direction keeps its old values (a
 // select, not a multiplication by zero, so not even the sign of a zero changes).
 template <SpringLayout L, bool kLambda, bool kScaled>
@@ -328,27 +355,10 @@ CAPE_AVX2 void solveBlocks8(const SpringSolveArrays& a, std::uint32_t begin, std
 }
 
 template <bool kLambda, bool kScaled>
-CAPE_AVX2 bool solveRun8(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
-  switch (run.layout) {
-    case SpringLayout::Contiguous:
-      solveBlocks8<SpringLayout::Contiguous, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-      return true;
-    case SpringLayout::PairSwapped:
-      solveBlocks8<SpringLayout::PairSwapped, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-      return true;
-    case SpringLayout::Interleaved:
-      solveBlocks8<SpringLayout::Interleaved, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-      return true;
-    case SpringLayout::Pairs:
-      solveBlocks8<SpringLayout::Pairs, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-      return true;
-    case SpringLayout::Gathered:
-      solveBlocks8<SpringLayout::Gathered, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-      return true;
-    case SpringLayout::Scalar:
-      break;
-  }
-  return false;
+bool solveRun8(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
+  return withVectorLayout(run.layout, [&](auto layout) {
+    solveBlocks8<decltype(layout)::value, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
+  });
 }
 
 #endif  // CAPE_HAVE_AVX2_KERNELS
@@ -358,21 +368,10 @@ void solveRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde
 #if CAPE_HAVE_AVX2_KERNELS
   if (useAvx2Kernels() && solveRun8<kLambda, kScaled>(a, run, alphaTilde)) return;
 #endif
-  switch (run.layout) {
-    case SpringLayout::Contiguous:
-      return solveBlocks<SpringLayout::Contiguous, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::PairSwapped:
-      return solveBlocks<SpringLayout::PairSwapped, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Interleaved:
-      return solveBlocks<SpringLayout::Interleaved, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Pairs:
-      return solveBlocks<SpringLayout::Pairs, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Gathered:
-      return solveBlocks<SpringLayout::Gathered, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
-    case SpringLayout::Scalar:
-      break;
-  }
-  scalarSprings<kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
+  const bool vector = withVectorLayout(run.layout, [&](auto layout) {
+    solveBlocks<decltype(layout)::value, kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
+  });
+  if (!vector) scalarSprings<kLambda, kScaled>(a, run.begin, run.end, alphaTilde);
 }
 
 }  // namespace
@@ -497,26 +496,10 @@ float maxSquaredStretch(const float* px, const float* py, const float* pz, const
   __m128 lanes = _mm_setzero_ps();
   float worst = 0.0f;
   for (const SpringRun& run : set.runs) {
-    switch (run.layout) {
-      case SpringLayout::Contiguous:
-        lanes = stretchBlocks<SpringLayout::Contiguous>(px, py, pz, set, run, lanes);
-        break;
-      case SpringLayout::PairSwapped:
-        lanes = stretchBlocks<SpringLayout::PairSwapped>(px, py, pz, set, run, lanes);
-        break;
-      case SpringLayout::Interleaved:
-        lanes = stretchBlocks<SpringLayout::Interleaved>(px, py, pz, set, run, lanes);
-        break;
-      case SpringLayout::Pairs:
-        lanes = stretchBlocks<SpringLayout::Pairs>(px, py, pz, set, run, lanes);
-        break;
-      case SpringLayout::Gathered:
-        lanes = stretchBlocks<SpringLayout::Gathered>(px, py, pz, set, run, lanes);
-        break;
-      case SpringLayout::Scalar:
-        worst = maxSquaredStretchScalar(px, py, pz, set, run.begin, run.end, worst);
-        break;
-    }
+    const bool vector = withVectorLayout(run.layout, [&](auto layout) {
+      lanes = stretchBlocks<decltype(layout)::value>(px, py, pz, set, run, lanes);
+    });
+    if (!vector) worst = maxSquaredStretchScalar(px, py, pz, set, run.begin, run.end, worst);
   }
   alignas(16) float l[4];
   _mm_store_ps(l, lanes);
