@@ -3,8 +3,12 @@
 
 #include "ShapeDistance.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace cape::detail {
 
@@ -38,6 +42,9 @@ struct PassArrays {
   float maxTravel;                         ///< the largest distance any particle moved in this substep, m
   Eigen::ArrayXf* distance2;               ///< scratch, one per particle
   std::vector<std::uint32_t>* candidates;  ///< scratch
+  /// Per block of kCullBlock consecutive particles: the centre of its box and the radius about it that
+  /// holds the block (x, y, z, radius), at the particles' positions before this pass.
+  const std::vector<Eigen::Vector4f>* blocks;
 };
 
 /// One collider's motion over the substep: its poses at s0 (A) and s1 (B), and bounds of how far a point at
@@ -75,19 +82,101 @@ inline void placeParticle(const CollisionArrays& p, Eigen::Index i, const Vec3& 
   p.pz[i] = xn.z();
 }
 
+/// The particles of a cull block (BodyCollision::collide's boxes): consecutive indices, so a grid's rows.
+constexpr Eigen::Index kCullBlock = 16;
+
+/// One pass over the particles before the colliders' passes: returns the largest squared distance a particle
+/// moved in this substep, and sets each block's sphere (kCullBlock consecutive particles: the centre of their
+/// box, and half its diagonal, a little more for rounding). Minima and maxima pass over NaN (a NaN particle
+/// fails every test of the broad phase anyway); an infinite coordinate makes its block's radius infinite, and
+/// such a block is never passed over.
+float travelAndBlocks(const CollisionArrays& p, std::vector<Eigen::Vector4f>& blocks) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  blocks.resize(static_cast<std::size_t>((p.n + kCullBlock - 1) / kCullBlock));
+  float maxTravel2 = 0.0f;
+  for (Eigen::Index first = 0, b = 0; first < p.n; first += kCullBlock, ++b) {
+    const Eigen::Index last = std::min(p.n, first + kCullBlock);
+    float lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+    Eigen::Index i = first;
+#if defined(__SSE2__)
+    // max(new, old) and min(new, old) keep the old value when the new one is NaN, as the scalar tail does.
+    __m128 travel = _mm_setzero_ps(), lx = _mm_set1_ps(kInf), ly = lx, lz = lx, hx = _mm_set1_ps(-kInf),
+           hy = hx, hz = hx;
+    for (; i + 4 <= last; i += 4) {
+      const __m128 x = _mm_loadu_ps(p.px + i), y = _mm_loadu_ps(p.py + i), z = _mm_loadu_ps(p.pz + i);
+      const __m128 dx = _mm_sub_ps(x, _mm_loadu_ps(p.sx + i)), dy = _mm_sub_ps(y, _mm_loadu_ps(p.sy + i)),
+                   dz = _mm_sub_ps(z, _mm_loadu_ps(p.sz + i));
+      travel = _mm_max_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)),
+                          travel);
+      lx = _mm_min_ps(x, lx);
+      ly = _mm_min_ps(y, ly);
+      lz = _mm_min_ps(z, lz);
+      hx = _mm_max_ps(x, hx);
+      hy = _mm_max_ps(y, hy);
+      hz = _mm_max_ps(z, hz);
+    }
+    alignas(16) float lanes[7][4];
+    _mm_store_ps(lanes[0], travel);
+    _mm_store_ps(lanes[1], lx);
+    _mm_store_ps(lanes[2], ly);
+    _mm_store_ps(lanes[3], lz);
+    _mm_store_ps(lanes[4], hx);
+    _mm_store_ps(lanes[5], hy);
+    _mm_store_ps(lanes[6], hz);
+    for (int k = 0; k < 4; ++k) {
+      maxTravel2 = std::max(maxTravel2, lanes[0][k]);
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], lanes[1 + a][k]);
+        hi[a] = std::max(hi[a], lanes[4 + a][k]);
+      }
+    }
+#endif
+    for (; i < last; ++i) {
+      const float x[3] = {p.px[i], p.py[i], p.pz[i]};
+      const float dx = x[0] - p.sx[i], dy = x[1] - p.sy[i], dz = x[2] - p.sz[i];
+      maxTravel2 = std::max(maxTravel2, dx * dx + dy * dy + dz * dz);
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], x[a]);
+        hi[a] = std::max(hi[a], x[a]);
+      }
+    }
+    const float ex = hi[0] - lo[0], ey = hi[1] - lo[1], ez = hi[2] - lo[2];
+    const float radius = 0.5f * std::sqrt(ex * ex + ey * ey + ez * ez) * (1.0f + 1e-6f);
+    blocks[static_cast<std::size_t>(b)] = {0.5f * (lo[0] + hi[0]), 0.5f * (lo[1] + hi[1]),
+                                           0.5f * (lo[2] + hi[2]), std::isnan(radius) ? kInf : radius};
+  }
+  return maxTravel2;
+}
+
 /// Broad phase, vectorised over all particles: the free particles that could reach the collider (a lower
 /// bound of the distance to its shape, or to the plane) within this substep go on to the exact test.
 template <ColliderShape S>
 void gatherCandidates(const Collider& c, const CollisionArrays& p, const PassArrays& q, const Sweep& w) {
-  Eigen::Map<const Eigen::ArrayXf> X(p.px, p.n), Y(p.py, p.n), Z(p.pz, p.n);
-  Eigen::ArrayXf& d2 = *q.distance2;
-  float reach = std::numeric_limits<float>::infinity();
+  std::vector<std::uint32_t>& candidates = *q.candidates;
+  candidates.clear();
   if constexpr (S == ColliderShape::Plane) {
     const Vec3 nw = w.B.rotation * c.normal;
     const float cw = c.constant + nw.dot(w.B.position);
+    Eigen::Map<const Eigen::ArrayXf> X(p.px, p.n), Y(p.py, p.n), Z(p.pz, p.n);
+    Eigen::ArrayXf& d2 = *q.distance2;
     d2 = X * nw.x() + Y * nw.y() + Z * nw.z() - cw;  // signed distance to the plane at s1
-    reach = w.turn > 0.0f ? std::numeric_limits<float>::infinity() : w.margin + w.shift + q.maxTravel;
-  } else if (w.turn < 0.5f) {
+    const float reach =
+        w.turn > 0.0f ? std::numeric_limits<float>::infinity() : w.margin + w.shift + q.maxTravel;
+    for (Eigen::Index i = 0; i < p.n; ++i)
+      if (d2[i] <= reach && p.w[i] != 0.0f) candidates.push_back(static_cast<std::uint32_t>(i));
+    return;
+  } else {
+    if (!(w.turn < 0.5f)) {
+      // Turning too fast to bound: every particle at a finite distance goes on to the exact test.
+      const float ox = w.B.position.x(), oy = w.B.position.y(), oz = w.B.position.z();
+      for (Eigen::Index i = 0; i < p.n; ++i) {
+        const float d2 = (p.px[i] - ox) * (p.px[i] - ox) + (p.py[i] - oy) * (p.py[i] - oy) +
+                         (p.pz[i] - oz) * (p.pz[i] - oz);
+        if (d2 <= std::numeric_limits<float>::infinity() && p.w[i] != 0.0f)
+          candidates.push_back(static_cast<std::uint32_t>(i));
+      }
+      return;
+    }
     // In the collider's frame at s1, a lower bound of each particle's signed distance to the shape (exact
     // for spheres, capsules and inside boxes and cylinders; the largest axis gap outside them), less the
     // most it can move relative to the collider in this substep: the narrow phase's test with every
@@ -106,42 +195,58 @@ void gatherCandidates(const Collider& c, const CollisionArrays& p, const PassArr
     const float radius = S == ColliderShape::ConvexHull ? c.hull->radius : c.radius;
     const float halfHeight = c.halfHeight, turn = w.turn;
     const float fixedReach = w.margin + w.shift + q.maxTravel * (1.0f + turn) + kSlack;
-    const float* __restrict px = p.px;
-    const float* __restrict py = p.py;
-    const float* __restrict pz = p.pz;
-    float* __restrict gap = d2.data();
-    for (Eigen::Index i = 0; i < p.n; ++i) {
-      const float rx = px[i] - ox, ry = py[i] - oy, rz = pz[i] - oz;
-      const float relNorm = std::sqrt(rx * rx + ry * ry + rz * rz);
-      float lower;
+    // The lower bound at (rx, ry, rz) from the collider's origin, |r| = relNorm. 1-Lipschitz in r for every
+    // shape (a distance, or the largest of distances to planes), which the block test below relies on.
+    const auto lowerBound = [=](float rx, float ry, float rz, float relNorm) {
       if constexpr (S == ColliderShape::Sphere || S == ColliderShape::ConvexHull) {
-        lower = relNorm - radius;  // a hull's bounding sphere
+        (void)rx, (void)ry, (void)rz;
+        return relNorm - radius;  // a hull's bounding sphere
       } else {
+        (void)relNorm;
         const float b0 = m00 * rx + m01 * ry + m02 * rz;
         const float b1 = m10 * rx + m11 * ry + m12 * rz;
         const float b2 = m20 * rx + m21 * ry + m22 * rz;
         if constexpr (S == ColliderShape::Box) {
-          lower = std::max(std::max(std::abs(b0) - hx, std::abs(b1) - hy), std::abs(b2) - hz);
+          return std::max(std::max(std::abs(b0) - hx, std::abs(b1) - hy), std::abs(b2) - hz);
         } else if constexpr (S == ColliderShape::Capsule) {
           const float beyond = std::abs(b0) - halfHeight;  // past the end of the segment, along the axis
           const float along =
               0.5f * (beyond + std::abs(beyond));  // max(beyond, 0), exactly, without a branch
-          lower = std::sqrt(along * along + b1 * b1 + b2 * b2) - radius;
+          return std::sqrt(along * along + b1 * b1 + b2 * b2) - radius;
         } else {
-          lower = std::max(std::sqrt(b1 * b1 + b2 * b2) - radius, std::abs(b0) - halfHeight);
+          return std::max(std::sqrt(b1 * b1 + b2 * b2) - radius, std::abs(b0) - halfHeight);
         }
       }
-      gap[i] = lower - (fixedReach + turn * relNorm);
+    };
+    const float* __restrict px = p.px;
+    const float* __restrict py = p.py;
+    const float* __restrict pz = p.pz;
+    float* __restrict gap = q.distance2->data();
+    const std::vector<Eigen::Vector4f>& blocks = *q.blocks;
+    const float originSize = std::abs(ox) + std::abs(oy) + std::abs(oz);
+    for (Eigen::Index b = 0, first = 0; first < p.n; ++b, first += kCullBlock) {
+      const Eigen::Index last = std::min(p.n, first + kCullBlock);
+      // The whole block first: every particle of it is within `rho` of the centre, so (the bound being
+      // 1-Lipschitz) its bound is at least the centre's less rho, and its distance from the origin at most
+      // the centre's plus rho. A block that clears the reach by more than the rounding of either evaluation
+      // is passed over: the particles' own test would keep none of it. A block that is not finite is not.
+      const Eigen::Vector4f& block = blocks[static_cast<std::size_t>(b)];
+      const float cx = block.x() - ox, cy = block.y() - oy, cz = block.z() - oz, rho = block.w();
+      const float centreNorm = std::sqrt(cx * cx + cy * cy + cz * cz);
+      const float tolerance = 1e-4f + 1e-5f * (originSize + std::abs(block.x()) + std::abs(block.y()) +
+                                               std::abs(block.z()) + centreNorm + rho + fixedReach);
+      const float blockGap =
+          lowerBound(cx, cy, cz, centreNorm) - rho - (fixedReach + turn * (centreNorm + rho));
+      if (blockGap > tolerance) continue;
+      for (Eigen::Index i = first; i < last; ++i) {
+        const float rx = px[i] - ox, ry = py[i] - oy, rz = pz[i] - oz;
+        const float relNorm = std::sqrt(rx * rx + ry * ry + rz * rz);
+        gap[i] = lowerBound(rx, ry, rz, relNorm) - (fixedReach + turn * relNorm);
+      }
+      for (Eigen::Index i = first; i < last; ++i)
+        if (gap[i] <= 0.0f && p.w[i] != 0.0f) candidates.push_back(static_cast<std::uint32_t>(i));
     }
-    reach = 0.0f;
-  } else {
-    // Turning too fast to bound: every particle at a finite distance goes on to the exact test.
-    d2 = (X - w.B.position.x()).square() + (Y - w.B.position.y()).square() + (Z - w.B.position.z()).square();
   }
-  std::vector<std::uint32_t>& candidates = *q.candidates;
-  candidates.clear();
-  for (Eigen::Index i = 0; i < p.n; ++i)
-    if (d2[i] <= reach && p.w[i] != 0.0f) candidates.push_back(static_cast<std::uint32_t>(i));
 }
 
 /// The narrow phase of one particle, in the collider's frame: it moves from a (its start, in the frame at
@@ -334,13 +439,8 @@ BodyCollision::BodyCollision(std::size_t particles) {
 
 void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settings, float h, float s0,
                             float s1, ColliderSpan colliders, bool explicitMode) {
-  PassArrays q{&contacts_, &contactPlanes_, 0, 0.0f, &distance2_, &candidates_};
-  float maxTravel2 = 0.0f;
-  for (Eigen::Index i = 0; i < p.n; ++i) {
-    const float dx = p.px[i] - p.sx[i], dy = p.py[i] - p.sy[i], dz = p.pz[i] - p.sz[i];
-    maxTravel2 = std::max(maxTravel2, dx * dx + dy * dy + dz * dz);
-  }
-  q.maxTravel = std::sqrt(maxTravel2);
+  PassArrays q{&contacts_, &contactPlanes_, 0, 0.0f, &distance2_, &candidates_, &blocks_};
+  q.maxTravel = std::sqrt(travelAndBlocks(p, blocks_));
   const float invH = 1.0f / h;
   contacts_.clear();
   contactPlanes_.clear();
@@ -351,6 +451,7 @@ void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settin
     if (!c.validate().ok()) continue;  // documented: an invalid collider (NaN pose, bad size) is skipped
     const float margin = settings.collisionThickness + c.thickness;
     const float mu = c.friction >= 0.0f ? c.friction : settings.friction;
+    const std::size_t contactsBefore = contacts_.size();
     switch (c.shape) {
       case ColliderShape::Sphere:
         collideWith<ColliderShape::Sphere>(c, p, q, s0, s1, margin, mu, invH, explicitMode);
@@ -373,6 +474,12 @@ void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settin
       case ColliderShape::TriangleMesh:
         collideMesh(c, p, q.collider, s0, s1, margin, mu, invH, explicitMode);
         break;
+    }
+    for (std::size_t k = contactsBefore; k < contacts_.size(); ++k) {
+      const std::uint32_t i = contacts_[k].particle;
+      Eigen::Vector4f& block = blocks_[i / static_cast<std::uint32_t>(kCullBlock)];
+      const float dx = p.px[i] - block.x(), dy = p.py[i] - block.y(), dz = p.pz[i] - block.z();
+      block.w() = std::max(block.w(), std::sqrt(dx * dx + dy * dy + dz * dz) * (1.0f + 1e-6f));
     }
   }
 }

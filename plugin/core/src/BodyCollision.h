@@ -58,6 +58,7 @@ class BodyCollision {
   std::vector<Cape::Contact> contacts_;         ///< Contacts of the substep's collision pass.
   Eigen::ArrayXf distance2_;                    ///< Broad-phase scratch, one per particle.
   std::vector<std::uint32_t> candidates_;       ///< Broad-phase scratch.
+  std::vector<Eigen::Vector4f> blocks_;         ///< Broad-phase culling: per block of particles, a sphere.
   std::vector<Eigen::Vector4f> contactPlanes_;  ///< Per contact: a mesh's contact plane (n, offset), else 0.
   // Triangle meshes: per mesh (in collider order), particle i's candidates are
   // meshCandidates_[meshStart_[slot * (n + 1) + i] .. meshStart_[slot * (n + 1) + i + 1]).
