@@ -435,6 +435,8 @@ BodyCollision::BodyCollision(std::size_t particles) {
   contactPlanes_.reserve(4 * particles);
   distance2_.resize(static_cast<Eigen::Index>(particles));
   candidates_.reserve(particles);
+  const auto block = static_cast<std::size_t>(kCullBlock);
+  blocks_.resize((particles + block - 1) / block);  // the broad phase's spheres: no step allocates
 }
 
 void BodyCollision::collide(const CollisionArrays& p, const CapeSettings& settings, float h, float s0,
