@@ -81,7 +81,8 @@ class BulletCapeRun final : public SceneRun {
 
   /// Levels of detail by distance (RunOptions::lodDistances) from the viewpoint (scene frame, relative to
   /// the scene's origin; by default 4 m behind the last row, 1.6 m up).
-  Status setDetail(const std::vector<double>& distances, const std::optional<Eigen::Vector3d>& viewpoint) {
+  Status setDetail(const std::vector<double>& distances, const std::optional<Eigen::Vector3d>& viewpoint,
+                   bool coarse) {
     if (distances.empty()) return Status::success();
     Eigen::Vector3d v = viewpoint.value_or(Eigen::Vector3d::Zero());
     if (!viewpoint) {
@@ -95,7 +96,7 @@ class BulletCapeRun final : public SceneRun {
       v = Eigen::Vector3d(0.5 * (minX + maxX), 1.6, maxZ + 4.0);
     }
     viewpoint_ = scene_->sceneToWorld().cast<double>() * v + scene_->origin();
-    const bullet::DetailLevel ladder[] = {{2, 0}, {4, 0}, {4, 2}};
+    const bullet::DetailLevel ladder[] = {{2, 0}, {4, 0, coarse}, {4, 2, coarse}};
     std::vector<bullet::DetailBand> bands;
     for (std::size_t k = 0; k < distances.size() && k < 3; ++k)
       bands.push_back({btScalar(distances[k]), ladder[k]});
@@ -176,7 +177,7 @@ std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& e
   auto run = std::make_unique<BulletCapeRun>(std::move(scene), options.threads);
   run->setParallelPrepare(options.parallelPrepare);
   if (!run->build(run->settings(), options.scene, error)) return nullptr;
-  if (Status s = run->setDetail(options.lodDistances, options.viewpoint); !s.ok()) {
+  if (Status s = run->setDetail(options.lodDistances, options.viewpoint, options.lodCoarse); !s.ok()) {
     error = "--lod: " + s.message();
     return nullptr;
   }

@@ -66,6 +66,9 @@ struct RunOptions {
   /// with 2 substeps per 1/60 s (cape::bullet::CapeGroup::setDetailPolicy, 0.5 m hysteresis). Empty: full
   /// detail for every cape.
   std::vector<double> lodDistances;
+  /// The levels beyond the second distance step the fabric's coarse level (--lod-coarse,
+  /// DetailLevel::coarseFabric).
+  bool lodCoarse = false;
   /// Where the levels of detail are measured from, m, in the scene's frame (Y up, the characters walking
   /// towards -Z) relative to `origin` (--viewpoint). Empty: 4 m behind the last row of characters at the
   /// middle of the rows, 1.6 m up.

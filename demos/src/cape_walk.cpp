@@ -110,6 +110,11 @@ int main(int argc, char** argv) {
           ->delimiter(',')
           ->expected(1, 3)
           ->transform(strictReal(0.0, 1e6));
+  bool lodCoarse = false;
+  app.add_flag("--lod-coarse", lodCoarse,
+               "with --lod: the capes beyond D2 step their grid's coarse level (a 20 x 20 cape's 10 x 10, "
+               "DetailLevel::coarseFabric), their particles interpolated from it")
+      ->needs(lodOption);
   app.add_option(
          "--viewpoint", viewpoint,
          "where --lod measures from (a camera), m, scene frame relative to --origin: X,Y,Z (default: 4 "
@@ -177,6 +182,7 @@ int main(int argc, char** argv) {
     }
   }
   o.lodDistances = lodDistances;
+  o.lodCoarse = lodCoarse;
   if (!viewpoint.empty()) {
     Eigen::Vector3d v;
     parseVector3(viewpoint, kMaxOrigin, v);  // checked above

@@ -575,19 +575,19 @@ void World::setWeightScale(int cape, bool mass, const Eigen::VectorXf& scale) {
   if (!s.ok()) fail(s.message());
 }
 
-void World::setDetailLevel(int cape, int stepInterval, int substeps) {
+void World::setDetailLevel(int cape, int stepInterval, int substeps, bool coarseFabric) {
   std::lock_guard<std::mutex> lock(mutex_);
   checkCape(cape);
   const cape::Status s =
-      capes_[static_cast<std::size_t>(cape)]->action->setDetailLevel({stepInterval, substeps});
+      capes_[static_cast<std::size_t>(cape)]->action->setDetailLevel({stepInterval, substeps, coarseFabric});
   if (!s.ok()) fail(s.message());
 }
 
-std::pair<int, int> World::detailLevel(int cape) const {
+std::tuple<int, int, bool> World::detailLevel(int cape) const {
   std::lock_guard<std::mutex> lock(mutex_);
   checkCape(cape);
   const cape::bullet::DetailLevel& d = capes_[static_cast<std::size_t>(cape)]->action->detailLevel();
-  return {d.stepInterval, d.substeps};
+  return {d.stepInterval, d.substeps, d.coarseFabric};
 }
 
 cape::Points World::capeAnimatedPositions(int cape) const {

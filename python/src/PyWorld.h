@@ -24,6 +24,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -139,9 +140,9 @@ class World {
   /// Cape::setMassScale (mass true) or setStiffnessScale: ValueError on bad values, the old scale kept.
   void setWeightScale(int cape, bool mass, const Eigen::VectorXf& scale);
   /// CapeAction::setDetailLevel: ValueError on a bad level, the old one kept.
-  void setDetailLevel(int cape, int stepInterval, int substeps);
+  void setDetailLevel(int cape, int stepInterval, int substeps, bool coarseFabric);
   /// The cape's level of detail: (step interval, substeps).
-  std::pair<int, int> detailLevel(int cape) const;
+  std::tuple<int, int, bool> detailLevel(int cape) const;
   void setMotionConstraints(int cape, const cape::MotionConstraints& constraints);
   /// Each particle's animated position of the last step (Cape::animatedPositions), m, world.
   cape::Points capeAnimatedPositions(int cape) const;

@@ -373,19 +373,19 @@ void bindHandles(py::module_& m) {
           "per particle, a weight map), in (0, 1e6]. ValueError on bad values; the old scale is kept then.")
       .def(
           "set_detail_level",
-          [](const CapeHandle& c, int stepInterval, int substeps) {
-            c.world->setDetailLevel(c.index, stepInterval, substeps);
+          [](const CapeHandle& c, int stepInterval, int substeps, bool coarseFabric) {
+            c.world->setDetailLevel(c.index, stepInterval, substeps, coarseFabric);
           },
-          "step_interval"_a = 1, "substeps"_a = 0,
+          "step_interval"_a = 1, "substeps"_a = 0, "coarse_fabric"_a = false,
           "Level of detail: the cape steps once every step_interval (1..64) internal steps of the world, "
-          "over "
-          "their time together, with substeps per 1/60 s (0: the settings' own). The state is kept as it is: "
-          "no particle jumps at a switch. (1, 0), the default, is full detail. ValueError on a bad level; "
-          "the "
-          "old one is kept then.")
+          "over their time together, with substeps per 1/60 s (0: the settings' own), and with coarse_fabric "
+          "on the grid's coarse level (a 20 x 20 cape's 10 x 10), its particles interpolated from it. No "
+          "particle jumps at a switch. (1, 0, False), the default, is full detail. ValueError on a bad "
+          "level; "
+          "the old one is kept then.")
       .def_property_readonly(
           "detail_level", [](const CapeHandle& c) { return c.world->detailLevel(c.index); },
-          "The level of detail: (step_interval, substeps).")
+          "The level of detail: (step_interval, substeps, coarse_fabric).")
       .def(
           "set_stiffness_scale",
           [](const CapeHandle& c, const py::object& scale) {

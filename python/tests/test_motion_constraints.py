@@ -96,14 +96,19 @@ def test_a_level_of_detail_steps_the_cape_less_often_and_bad_levels_raise():
         return cape
 
     full = hang()
-    assert full.detail_level == (1, 0)
+    assert full.detail_level == (1, 0, False)
     assert np.array_equal(full.positions, hang((1, 0)).positions)  # full detail changes no bit
     coarse = hang((4, 2))
-    assert coarse.detail_level == (4, 2)
+    assert coarse.detail_level == (4, 2, False)
     assert np.isfinite(coarse.positions).all()
     gap = np.linalg.norm(coarse.positions - full.positions, axis=1).max()
     assert 0 < gap < 0.05  # another solve of the same hang, a few cm at most from it
+    # On the grid's coarse level (10 x 10 for the 20 x 20 cape), interpolated: as close to the full hang.
+    halved = hang((4, 2, True))
+    assert halved.detail_level == (4, 2, True)
+    assert halved.positions.shape == full.positions.shape
+    assert 0 < np.linalg.norm(halved.positions - full.positions, axis=1).max() < 0.05
     for bad in [(0, 0), (65, 0), (1, -1)]:
         with pytest.raises(ValueError, match="DetailLevel"):
             coarse.set_detail_level(*bad)
-    assert coarse.detail_level == (4, 2)
+    assert coarse.detail_level == (4, 2, False)

@@ -171,17 +171,19 @@ void BM_CrowdFrame(benchmark::State& state) {
 
 /// The same crowd seen from a camera 4 m in front of its middle at eye height, with levels of detail by
 /// distance (CapeGroup::setDetailPolicy): full detail within 8 m, every second internal step to 16 m, once a
-/// frame to 32 m, once a frame with 2 substeps beyond. Reported besides: the capes in each band.
+/// frame to 32 m, and beyond that with 2 substeps; C = 1: the last two bands on the fabric's coarse level
+/// (10 x 10, DetailLevel::coarseFabric). Reported besides: the capes in each band.
 void BM_CrowdFrameDetail(benchmark::State& state) {
   const int count = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
   Crowd crowd(count, threads, state.range(2) != 0);
+  const bool coarse = state.range(3) != 0;
   btScalar front = 0;
   for (int k = 0; k < count; ++k) front = std::max(front, btScalar(gridOffset(k, count).z()));
   using cape::bullet::DetailLevel;
-  const cape::Status policy =
-      crowd.group.setDetailPolicy(btVector3(0, btScalar(1.6), front + 4),
-                                  {{8, DetailLevel{2, 0}}, {16, DetailLevel{4, 0}}, {32, DetailLevel{4, 2}}});
+  const cape::Status policy = crowd.group.setDetailPolicy(
+      btVector3(0, btScalar(1.6), front + 4),
+      {{8, DetailLevel{2, 0}}, {16, DetailLevel{4, 0, coarse}}, {32, DetailLevel{4, 2, coarse}}});
   if (!policy.ok()) {
     state.SkipWithError(policy.message().c_str());
     return;
@@ -216,6 +218,13 @@ void crowdArgs(benchmark::internal::Benchmark* b, std::initializer_list<int> cou
   b->Iterations(120)->Unit(benchmark::kMillisecond);
 }
 
-BENCHMARK(BM_CrowdFrameDetail)->Apply([](benchmark::internal::Benchmark* b) { crowdArgs(b, {100, 1000}); });
+BENCHMARK(BM_CrowdFrameDetail)->Apply([](benchmark::internal::Benchmark* b) {
+  b->ArgNames({"K", "T", "P", "C"});
+  for (int coarse : {0, 1})
+    for (int k : {100, 1000})
+      for (const auto& [threads, parallel] : {std::pair{1, 0}, std::pair{2, 0}, std::pair{2, 1}})
+        b->Args({k, threads, parallel, coarse});
+  b->Iterations(120)->Unit(benchmark::kMillisecond);
+});
 BENCHMARK(BM_CrowdFrame)->Apply([](benchmark::internal::Benchmark* b) { crowdArgs(b, {16, 100, 1000}); });
 BENCHMARK_MAIN();

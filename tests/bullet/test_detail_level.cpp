@@ -80,7 +80,9 @@ TEST(DetailLevel, CoarseLevelsWalkCloseToFullDetail) {
   // Every second internal step, once a frame (4 -> 3 substeps a frame), and once a frame with 2 substeps:
   // after the first second (the drop onto the body) the walk stays within a few cm of the full-detail twin,
   // pinned, out of the body and stretched by a few per cent.
-  for (const DetailLevel level : {DetailLevel{2, 0}, DetailLevel{4, 0}, DetailLevel{4, 2}}) {
+  for (const DetailLevel level :
+       {DetailLevel{2, 0}, DetailLevel{4, 0}, DetailLevel{4, 2}, DetailLevel{1, 0, true},
+        DetailLevel{4, 0, true}, DetailLevel{4, 2, true}}) {
     Twins t;
     ASSERT_TRUE(t.lod.action->setDetailLevel(level).ok());
     for (int f = 0; f < 60; ++f) t.advance();
@@ -94,8 +96,8 @@ TEST(DetailLevel, CoarseLevelsWalkCloseToFullDetail) {
       fullStrain = std::max(fullStrain, maxStructuralStrain(t.full.action->cape()));
       lodStrain = std::max(lodStrain, maxStructuralStrain(t.lod.action->cape()));
     }
-    const std::string what =
-        "interval " + std::to_string(level.stepInterval) + ", substeps " + std::to_string(level.substeps);
+    const std::string what = "interval " + std::to_string(level.stepInterval) + ", substeps " +
+                             std::to_string(level.substeps) + (level.coarseFabric ? ", coarse fabric" : "");
     EXPECT_LT(gap, 0.04f) << what;
     // With 2 substeps a frame the strain refinement (CapeSettings::strainLimit, 5 %) is what holds it.
     EXPECT_LT(lodStrain, 1.2f * t.lod.action->cape().settings().strainLimit) << what;
@@ -110,10 +112,12 @@ TEST(DetailLevel, SwitchingEitherWayMovesNoParticle) {
   // Full -> every 4th step -> full -> once a frame with 2 substeps -> full, one second each: in the frame
   // of each switch no particle moves more than 1 cm differently from the full-detail twin.
   Twins t;
-  const DetailLevel plan[] = {DetailLevel{}, DetailLevel{4, 0}, DetailLevel{}, DetailLevel{4, 2},
-                              DetailLevel{}};
+  const DetailLevel plan[] = {
+      DetailLevel{},     DetailLevel{4, 0},       DetailLevel{}, DetailLevel{4, 2},
+      DetailLevel{},     DetailLevel{4, 2, true}, DetailLevel{}, DetailLevel{1, 0, true},
+      DetailLevel{4, 0}, DetailLevel{4, 0, true}, DetailLevel{}};
   float worstSwitch = 0;
-  for (int f = 0; f < 300; ++f) {
+  for (int f = 0; f < 660; ++f) {
     if (f % 60 == 0) {
       ASSERT_TRUE(t.lod.action->setDetailLevel(plan[f / 60]).ok());
     }
@@ -212,6 +216,41 @@ TEST(CapeGroupDetail, BandsByDistanceWithHysteresis) {
   w.world->removeAction(&group);
 }
 
+TEST(DetailLevel, ACoarseFabricNeedsAGridFabric) {
+  // A fabric built from a mesh has no coarse level: setDetailLevel refuses it and keeps the level in use; a
+  // group's policy gives such a cape the band's interval and substeps on its own fabric.
+  cape::MeshDesc m;
+  m.positions = {cape::Vec3(0, 0, 0), cape::Vec3(0.5f, 0, 0), cape::Vec3(0, -0.5f, 0),
+                 cape::Vec3(0.5f, -0.5f, 0)};
+  m.triangles = {2, 3, 1, 2, 1, 0};
+  const cape::FabricPtr mesh = cape::Fabric::fromMesh(m).fabric;
+  ASSERT_TRUE(mesh);
+  World w;
+  w.world->setGravity(btVector3(0, 0, 0));
+  CapeAction onMesh(mesh, cape::CapeSettings(),
+                    btTransform(btQuaternion::getIdentity(), btVector3(40, 1, 0)));
+  ASSERT_TRUE(onMesh.setDetailLevel(DetailLevel{2, 0}).ok());
+  const cape::Status s = onMesh.setDetailLevel(DetailLevel{4, 2, true});
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("coarse level"), std::string::npos) << s.message();
+  EXPECT_EQ(onMesh.detailLevel(), (DetailLevel{2, 0}));
+  EXPECT_FALSE(onMesh.cape().coarseLevel());
+  std::unique_ptr<CapeAction> onGrid = floatingCape(btVector3(-40, 1, 0));
+  CapeGroup group(1);
+  group.add(&onMesh);
+  group.add(onGrid.get());
+  w.world->addAction(&group);
+  ASSERT_TRUE(group.setDetailPolicy(btVector3(0, 1, 0), {{30, DetailLevel{4, 2, true}}}).ok());
+  w.world->stepSimulation(kFrame, 8, kFixed);
+  EXPECT_EQ(onMesh.detailLevel(), (DetailLevel{4, 2}));
+  EXPECT_EQ(onGrid->detailLevel(), (DetailLevel{4, 2, true}));
+  EXPECT_TRUE(onGrid->cape().steppedCoarse());
+  EXPECT_FALSE(onMesh.cape().steppedCoarse());
+  EXPECT_EQ(onMesh.stepCount(), 1u);
+  EXPECT_EQ(onGrid->stepCount(), 1u);
+  w.world->removeAction(&group);
+}
+
 TEST(CapeGroupDetail, BadPoliciesAreRefusedAndThePolicyKept) {
   CapeGroup group(1);
   const DetailLevel half{2, 0};
@@ -244,7 +283,8 @@ TEST(CapeGroupDetail, OneAndTwoThreadsGiveIdenticalBitsWithAPolicy) {
     }
     w.world->addAction(&group);
     EXPECT_TRUE(
-        group.setDetailPolicy(btVector3(0, 1.5f, 2), {{5, DetailLevel{2, 0}}, {12, DetailLevel{4, 2}}}).ok());
+        group.setDetailPolicy(btVector3(0, 1.5f, 2), {{5, DetailLevel{2, 0}}, {12, DetailLevel{4, 2, true}}})
+            .ok());
     for (int f = 0; f < 60; ++f) {
       for (auto& walk : walks) {  // each walk's bodies to this frame's pose, then one step of the world
         ++walk->frame;

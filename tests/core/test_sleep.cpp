@@ -1,5 +1,7 @@
 // Sleeping (CapeSettings::sleepSpeed): a cape at rest among still colliders stops simulating, changes nothing
 // while asleep, and wakes the very step anything it feels changes.
+#include "HangingCape.h"
+
 #include "cape/core/Cape.h"
 #include "cape/scenes/Scene.h"
 
@@ -13,36 +15,8 @@
 namespace cape {
 namespace {
 
-Pose at(const Vec3& position) {
-  Pose p;
-  p.position = position;
-  return p;
-}
-
-// The canonical cape hung by its two top corners in front of a still torso box and shoulder spheres.
-struct Hanging {
-  CapeRig rig = makeCapeRig(20, PinLayout::Corners);
-  Cape cape;
-  std::vector<Collider> colliders;
-
-  explicit Hanging(const CapeSettings& settings)
-      : cape(rig.fabric, settings, capeStartPlacement(SceneKind::Walk)) {
-    EXPECT_TRUE(cape.ok()) << cape.status().message();
-    for (std::size_t k = 0; k < rig.pinnedParticles.size(); ++k)
-      cape.pin(rig.pinnedParticles[k], rig.pinLocalPoints[k]);
-    colliders.push_back(Collider::box(Vec3(0.18f, 0.3f, 0.1f), at(Vec3(0.0f, 1.2f, 0.0f))));
-    colliders.push_back(Collider::sphere(0.08f, at(Vec3(-0.22f, 1.52f, 0.0f))));
-    colliders.push_back(Collider::sphere(0.08f, at(Vec3(0.22f, 1.52f, 0.0f))));
-  }
-  void frames(int count) {
-    for (int f = 0; f < count; ++f) cape.step(1.0f / 60.0f, colliders);
-  }
-  // Moves every pin by `d` (the pins' targets at the end of the next step).
-  void movePins(const Vec3& d) {
-    for (std::size_t k = 0; k < cape.state().pins.size(); ++k)
-      cape.movePin(k, cape.state().pins[k].target + d);
-  }
-};
+using test::at;
+using test::Hanging;
 
 float largestDifference(const Points& a, const Points& b) {
   return (a - b).rowwise().norm().maxCoeff();

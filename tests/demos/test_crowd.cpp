@@ -199,6 +199,15 @@ TEST(Crowd, LevelsOfDetailByDistanceFromTheViewpoint) {
   EXPECT_NEAR(mixed["detail"]["viewpoint_m"][2].get<double>(), 7.0, 0.2);
   EXPECT_NE(mixed["state_hashes"], plain["state_hashes"]);
   EXPECT_EQ(counts("--lod 2,4 --viewpoint 0,1.6,1000"), (std::vector<int>{0, 0, 16}));
+  // --lod-coarse: the same bands, the far ones on the fabric's coarse level: another result, as many
+  // capes in each band, every cape finite.
+  json coarse;
+  EXPECT_EQ(counts("--lod 6,8,10 --lod-coarse", &coarse), m);
+  EXPECT_NE(coarse["state_hashes"], mixed["state_hashes"]);
+  EXPECT_FALSE(coarse["summary"]["blow_up"].get<bool>());
+  const Result alone = run(crowd + " --lod-coarse --out " + (freshDir() / "run").string());
+  EXPECT_NE(alone.exitCode, 0);
+  EXPECT_NE(alone.output.find("--lod"), std::string::npos) << alone.output;
 }
 
 TEST(Crowd, APrepareOnTheWorkersGivesTheSameCapes) {

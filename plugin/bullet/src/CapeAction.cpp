@@ -730,7 +730,12 @@ Status DetailLevel::validate() const {
 Status CapeAction::setDetailLevel(const DetailLevel& level) {
   if (Status s = level.validate(); !s.ok()) return s;
   if (!ok()) return Status::error("CapeAction::setDetailLevel: the cape was not made");
+  if (level.coarseFabric && !cape_.fabric().coarseLevel())
+    return Status::error(
+        "CapeAction::setDetailLevel: coarseFabric needs a grid fabric of at least 3 x 3 particles "
+        "(Fabric::coarseLevel); this cape's has no coarse level");
   if (Status s = cape_.setSubstepOverride(level.substeps); !s.ok()) return s;
+  if (Status s = cape_.setCoarseLevel(level.coarseFabric); !s.ok()) return s;
   detail_ = level;
   return Status::success();
 }

@@ -107,8 +107,12 @@ void CapeGroup::applyDetailPolicy() {
       while (b > 0 && d < bands_[static_cast<std::size_t>(b - 1)].distance - hysteresis_) --b;
     }
     if (b != band_[i]) {
-      // Validated with the policy; a cape that was not made refuses, and stays as it is.
-      capes_[i]->setDetailLevel(b == 0 ? DetailLevel() : bands_[static_cast<std::size_t>(b - 1)].level);
+      // Validated with the policy; a cape that was not made refuses, and stays as it is. A cape whose
+      // fabric has no coarse level takes the band's interval and substeps on its own fabric.
+      DetailLevel level = b == 0 ? DetailLevel() : bands_[static_cast<std::size_t>(b - 1)].level;
+      if (level.coarseFabric && capes_[i]->ok() && !capes_[i]->cape().fabric().coarseLevel())
+        level.coarseFabric = false;
+      capes_[i]->setDetailLevel(level);
       band_[i] = b;
     }
     ++bandCounts_[static_cast<std::size_t>(b)];

@@ -5,6 +5,7 @@
 #include "cape/core/Wind.h"
 
 #include "CapeScratch.h"
+#include "CoarseLevel.h"
 #include "SpringSolver.h"
 
 #include <Eigen/SVD>
@@ -252,6 +253,9 @@ Status Cape::setSettings(const CapeSettings& settings) {
     return stable;
   settings_ = settings;
   wake();
+  // The coarse level keeps the settings it has if it refuses these (only the explicit integrator's
+  // stability check can, and its longer springs are the more stable).
+  if (coarse_) coarse_->cape.setSettings(settings);
   for (int f = 0; f < kSpringFamilyCount; ++f) {
     const float k = stiffnessOf(settings_, f);
     familyCompliance_[static_cast<std::size_t>(f)] = k > 0.0f ? 1.0f / k : kInf;  // inf compliance = off
@@ -264,6 +268,7 @@ Status Cape::setSubstepOverride(int substeps) {
     return Status::error("Cape::setSubstepOverride: substeps must be 0 (none) or in 1..1000, not " +
                          std::to_string(substeps));
   substepOverride_ = substeps;
+  if (coarse_) coarse_->cape.setSubstepOverride(substeps);
   return Status::success();
 }
 
@@ -280,6 +285,7 @@ std::size_t Cape::pin(std::uint32_t particle, const Vec3& target) {
   state_.inverseMasses[particle] = 0.0f;
   state_.pins.push_back({particle, target, target});
   markPinnedComponents();
+  if (coarse_) coarse_->pinsStale = true;
   return state_.pins.size() - 1;
 }
 
@@ -290,6 +296,7 @@ void Cape::unpin(std::uint32_t particle) {
   if (it == state_.pins.end()) return;
   wake();
   state_.pins.erase(it);
+  if (coarse_) coarse_->pinsStale = true;
   state_.inverseMasses[particle] =
       1.0f / (fabric_->masses()[particle] * (massScale_.size() > 0 ? massScale_[particle] : 1.0f));
   markPinnedComponents();
@@ -388,12 +395,14 @@ void Cape::setOrigin(const Eigen::Vector3d& origin) {
     p.target += d;
   }
   reference_.position += d;
+  if (coarse_ && !coarse_->stale) coarse_->cape.setOrigin(origin);
 }
 
 void Cape::relocate(const Eigen::Vector3d& origin) {
   if (!ok() || !origin.allFinite() || origin == origin_) return;
   wake();  // the colliders it sleeps among are in the old frame's coordinates
   origin_ = origin;
+  if (coarse_ && !coarse_->stale) coarse_->cape.relocate(origin);
 }
 
 void Cape::teleport(const Pose& delta) {
@@ -409,6 +418,10 @@ void Cape::teleport(const Pose& delta) {
   for (Pin& p : state_.pins) {
     p.previousTarget = delta.apply(p.previousTarget);
     p.target = delta.apply(p.target);
+  }
+  if (coarse_ && !coarse_->stale) {
+    coarse_->cape.teleport(delta);
+    coarse_->turnOffset(r);
   }
 }
 
@@ -426,6 +439,7 @@ void Cape::resetToReference() {
   state_.velocities.setZero();
   work_->startPositions = state_.positions;
   work_->self.forget();
+  markCoarseStale();
 }
 
 void Cape::carry(const Eigen::Matrix3f& m, const Vec3& centre, const Vec3& shift) {
@@ -440,11 +454,20 @@ void Cape::carry(const Eigen::Matrix3f& m, const Vec3& centre, const Vec3& shift
     state_.velocities.row(i) = (m * Vec3(state_.velocities.row(i).transpose())).transpose();
   }
   for (Pin& p : state_.pins) p.previousTarget = m * (p.previousTarget - centre) + centre + shift;
+  if (coarse_ && !coarse_->stale) {
+    coarse_->cape.carry(m, centre, shift);
+    coarse_->turnOffset(m);
+  }
 }
 
 void Cape::step(float dt, ColliderSpan colliders) {
   if (!ok() || !std::isfinite(dt) || !(dt > 0.0f)) return;
   dt = std::min(dt, kMaxStep);
+  if (coarseOn_ && coarseUsable()) {
+    stepCoarse(dt, colliders);
+    return;
+  }
+  if (steppedCoarse_) leaveCoarse();
   const bool still = surroundingsStill(colliders);
   if (asleep_) {
     if (still && work_->sleep.same(colliders)) {
@@ -477,6 +500,7 @@ void Cape::step(float dt, ColliderSpan colliders) {
 void Cape::wake() {
   asleep_ = false;
   stillTime_ = 0.0f;
+  if (coarse_) coarse_->cape.wake();
 }
 
 bool Cape::surroundingsStill(ColliderSpan colliders) const {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <mutex>
 #include <numeric>
 #include <utility>
 
@@ -214,6 +215,8 @@ FabricResult Fabric::grid(const GridDesc& d) {
   auto id = [nc](int r, int c) { return static_cast<std::uint32_t>(r * nc + c); };
   f->gridColumns_ = nc;
   f->gridRows_ = nr;
+  f->gridDesc_ = d;
+  f->coarse_ = std::make_shared<CoarseCache>();
   f->restPositions_.resize(n, 3);
   f->uvs_.resize(n);
   for (int r = 0; r < nr; ++r) {
@@ -272,6 +275,35 @@ FabricResult Fabric::grid(const GridDesc& d) {
   result.status = f->finish(d.tetherAnchors, d.tethersPerParticle, d.tetherScale);
   if (result.status.ok()) result.fabric = std::move(f);
   return result;
+}
+
+struct Fabric::CoarseCache {
+  std::once_flag once;
+  FabricPtr fabric;
+};
+
+FabricPtr Fabric::coarseLevel() const {
+  if (!coarse_ || gridColumns_ < 3 || gridRows_ < 3) return nullptr;
+  std::call_once(coarse_->once, [this] {
+    GridDesc d = gridDesc_;
+    d.columns = (gridColumns_ + 1) / 2;
+    d.rows = (gridRows_ + 1) / 2;
+    // Each anchor to the coarse particle nearest it (the grids span the same rectangle), once.
+    const auto nearest = [](int i, int fine, int coarse) {
+      return static_cast<int>(std::lround(static_cast<double>(i) * (coarse - 1) / (fine - 1)));
+    };
+    std::vector<std::uint32_t> anchors;
+    for (const std::uint32_t a : gridDesc_.tetherAnchors) {
+      const int r = nearest(static_cast<int>(a) / gridColumns_, gridRows_, d.rows);
+      const int c = nearest(static_cast<int>(a) % gridColumns_, gridColumns_, d.columns);
+      anchors.push_back(static_cast<std::uint32_t>(r * d.columns + c));
+    }
+    std::sort(anchors.begin(), anchors.end());
+    anchors.erase(std::unique(anchors.begin(), anchors.end()), anchors.end());
+    d.tetherAnchors = std::move(anchors);
+    coarse_->fabric = grid(d).fabric;  // the fine grid's description was valid, so is this one
+  });
+  return coarse_->fabric;
 }
 
 FabricResult Fabric::fromMesh(const MeshDesc& d) {

@@ -112,7 +112,9 @@ struct CapeActionSettings {
 
 /// A level of detail: how often and how finely a cape steps (CapeAction::setDetailLevel, or by distance
 /// from a viewpoint with CapeGroup::setDetailPolicy). The cape's state is carried across a switch as it is
-/// (the same particles, pins and velocities), so no particle jumps when the level changes.
+/// (the same particles, pins and velocities), so no particle jumps when the level changes; to and from a
+/// coarse fabric the coarse particles start from the cape's state and the fine detail fades over
+/// Cape::kCoarseBlendTime (Cape::setCoarseLevel).
 struct DetailLevel {
   /// The cape steps once every this many internal steps of the world (1..kMaxStepInterval), over their
   /// time together: the pins and colliders are swept over the longer step, discovery looks as many times
@@ -121,18 +123,23 @@ struct DetailLevel {
   int stepInterval = 1;
   /// Substeps per CapeSettings::timeStep at this level (Cape::setSubstepOverride); 0: the settings' own.
   int substeps = 0;
+  /// Step the fabric's coarse level (Cape::setCoarseLevel, Fabric::coarseLevel: a 20 x 20 grid's 10 x 10)
+  /// and interpolate the cape's particles from it: about a quarter of the work per substep. Grid fabrics
+  /// only (CapeAction::setDetailLevel refuses it for a fabric without a coarse level; a CapeGroup policy
+  /// steps such a cape on its own fabric at the band's interval and substeps).
+  bool coarseFabric = false;
 
   /// The largest stepInterval.
   static constexpr int kMaxStepInterval = 64;
   /// An error naming the field for an interval outside 1..kMaxStepInterval or substeps outside 0..1000.
   Status validate() const;
-  /// Full detail: every internal step, the settings' substeps.
-  bool full() const { return stepInterval == 1 && substeps == 0; }
-  /// The same interval and substeps.
+  /// Full detail: every internal step, the settings' substeps, the cape's own fabric.
+  bool full() const { return stepInterval == 1 && substeps == 0 && !coarseFabric; }
+  /// The same interval, substeps and fabric.
   bool operator==(const DetailLevel& o) const {
-    return stepInterval == o.stepInterval && substeps == o.substeps;
+    return stepInterval == o.stepInterval && substeps == o.substeps && coarseFabric == o.coarseFabric;
   }
-  /// A different interval or substeps.
+  /// A different interval, substeps or fabric.
   bool operator!=(const DetailLevel& o) const { return !(*this == o); }
 };
 

@@ -99,6 +99,23 @@ class CAPE_CORE_API Cape {
   Status setSubstepOverride(int substeps);
   /// The substep override in use (0: none, settings().substeps apply).
   int substepOverride() const { return substepOverride_; }
+  /// Level of detail by fabric: while on, each step simulates the fabric's coarse level
+  /// (Fabric::coarseLevel: a 20 x 20 grid's 10 x 10, with the same settings, pins and colliders) in this
+  /// cape's place, and this cape's particles follow it: positions and velocities interpolated bilinearly
+  /// over the grid from the coarse particles, pinned particles on their pins. The switch moves no particle
+  /// at once: switching on, the coarse level starts from this cape's state sampled at its particles, and the
+  /// fine detail the coarse grid cannot hold (folds between its particles) fades out linearly over
+  /// kCoarseBlendTime of simulated time; switching off, this cape steps on from the interpolated state it
+  /// shows. A cape with a mass or stiffness scale, motion constraints or animated positions set steps its
+  /// own fabric while they are set (they are per particle of it). An error, changing nothing, for a fabric
+  /// without a coarse level (built by Fabric::fromMesh, or a grid under 3 x 3).
+  Status setCoarseLevel(bool on);
+  /// Whether the coarse level is on (setCoarseLevel).
+  bool coarseLevel() const { return coarseOn_; }
+  /// True when the last step simulated the coarse level.
+  bool steppedCoarse() const { return steppedCoarse_; }
+  /// s of simulated time over which the fine detail left at a switch to the coarse level fades out.
+  static constexpr float kCoarseBlendTime = 0.25f;
   /// Gravity for the next steps (m/s^2, world frame), e.g. the world's, read before every step. Not finite:
   /// an error, and the gravity stays what it was.
   Status setGravity(const Vec3& gravity);
@@ -108,6 +125,7 @@ class CAPE_CORE_API Cape {
   /// the cape (whatever is done with the state may move it).
   CapeState& mutableState() {
     wake();
+    markCoarseStale();
     return state_;
   }
 
@@ -286,8 +304,21 @@ class CAPE_CORE_API Cape {
   bool surroundingsStill(ColliderSpan colliders) const;
   void updateSleep(float dt, bool still, ColliderSpan colliders);
 
+  /// The coarse level's cape and what carries state between the levels (Cape.cpp).
+  struct CoarseLevel;
+  bool coarseUsable() const;
+  void stepCoarse(float dt, ColliderSpan colliders);
+  void restrictToCoarse();
+  void rebuildCoarsePins();
+  void leaveCoarse();
+  /// The coarse level starts again from this cape's state at its next step.
+  void markCoarseStale();
+
   FabricPtr fabric_;
   CapeSettings settings_;
+  std::unique_ptr<CoarseLevel> coarse_;  ///< Made by the first setCoarseLevel(true).
+  bool coarseOn_ = false;
+  bool steppedCoarse_ = false;
   std::array<float, kSpringFamilyCount> familyCompliance_{};  ///< 1 / stiffness per family, m/N (inf: off).
   int substepOverride_ = 0;     ///< Substeps per timeStep in place of the settings' (0: none).
   int refinement_ = 1;          ///< Substep multiplier of the next step (1, 2, 4, ...).

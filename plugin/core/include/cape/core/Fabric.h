@@ -223,6 +223,16 @@ class CAPE_CORE_API Fabric {
   /// Per cluster, the particles local to all its triangles.
   const std::vector<ClusterLocalSet>& clusterLocal() const { return clusterLocal_; }
 
+  /// The coarse level of a grid fabric, which a cape steps in its place at a coarse level of detail
+  /// (Cape::setCoarseLevel): the same size, mass, springs and tether settings over (columns + 1) / 2 x
+  /// (rows + 1) / 2 particles (a 20 x 20 grid's is 10 x 10, about a quarter of the work), each tether anchor
+  /// carried to the coarse particle nearest it. Built on the first call (thread-safe) and shared by every
+  /// cape of this fabric. Null for a fabric built by fromMesh() and for a grid with fewer than 3 particles
+  /// along either side (nothing coarser to step).
+  FabricPtr coarseLevel() const;
+  /// The description a grid fabric was built from (GridDesc's defaults for a mesh fabric).
+  const GridDesc& gridDesc() const { return gridDesc_; }
+
  private:
   Fabric() = default;
   /// Derived data in one explicit pass: colouring and runs, rest lengths, diameter, spacing, tethers, the
@@ -248,6 +258,10 @@ class CAPE_CORE_API Fabric {
   std::vector<Eigen::Vector2f> uvs_;
   int gridColumns_ = 0;
   int gridRows_ = 0;
+  GridDesc gridDesc_;
+  /// coarseLevel()'s fabric, built once (a pointer, so that the fabric stays movable while it is built).
+  struct CoarseCache;
+  std::shared_ptr<CoarseCache> coarse_;
   float restDiameter_ = 0.0f;
   std::vector<std::uint32_t> components_;
   std::uint32_t componentCount_ = 0;
