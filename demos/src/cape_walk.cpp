@@ -455,6 +455,7 @@ int main(int argc, char** argv) {
   if (!o.lodDistances.empty()) {
     const Eigen::Vector3d v = run->detailViewpoint();
     summary["detail"] = {{"distances_m", o.lodDistances},
+                         {"coarse_fabric_beyond_second", o.lodCoarse},
                          {"viewpoint_m", {v.x(), v.y(), v.z()}},
                          {"capes_per_level_last_frame", run->detailCounts()}};
   }

@@ -184,6 +184,27 @@ TEST(CoarseFabric, DeterministicAndRigidUnderTeleport) {
   EXPECT_LT(largestPinError(a.cape), 1e-6f);
 }
 
+TEST(CoarseFabric, AMovedFrameKeepsTheCoarseLevelWhereItIs) {
+  // The Bullet adapter moves a cape's frame along with its character (Cape::setOrigin): the coarse level's
+  // frame moves with it, so the cape stays where it is in the world and steps on as its twin does.
+  Hanging still(walkSettings()), moved(walkSettings());
+  ASSERT_TRUE(still.cape.setCoarseLevel(true).ok());
+  ASSERT_TRUE(moved.cape.setCoarseLevel(true).ok());
+  still.frames(20);
+  moved.frames(20);
+  const Eigen::Vector3d origin(16.0, 0.0, -32.0);
+  moved.cape.setOrigin(origin);
+  const Vec3 shift = (-origin).cast<float>();
+  for (Collider& c : moved.colliders) c.teleportTo(test::at(c.current.position + shift));
+  for (std::size_t k = 0; k < moved.cape.state().pins.size(); ++k)
+    EXPECT_EQ(moved.cape.state().pins[k].target, still.cape.state().pins[k].target + shift);
+  still.frames(40);
+  moved.frames(40);
+  EXPECT_TRUE(moved.cape.steppedCoarse());
+  const Points world = moved.cape.state().positions.rowwise() - shift.transpose();
+  EXPECT_LT(largestDifference(world, still.cape.state().positions), 1e-4f);
+}
+
 TEST(CoarseFabric, PerParticleMapsKeepTheCapeOnItsOwnFabric) {
   // A mass scale, a stiffness scale or motion constraints are per particle of the fabric: while one is set
   // the cape steps its own fabric whatever the level, and the same bits as a cape without the level.

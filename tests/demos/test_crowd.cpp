@@ -205,6 +205,8 @@ TEST(Crowd, LevelsOfDetailByDistanceFromTheViewpoint) {
   EXPECT_EQ(counts("--lod 6,8,10 --lod-coarse", &coarse), m);
   EXPECT_NE(coarse["state_hashes"], mixed["state_hashes"]);
   EXPECT_FALSE(coarse["summary"]["blow_up"].get<bool>());
+  EXPECT_TRUE(coarse["detail"]["coarse_fabric_beyond_second"].get<bool>());
+  EXPECT_FALSE(mixed["detail"]["coarse_fabric_beyond_second"].get<bool>());
   const Result alone = run(crowd + " --lod-coarse --out " + (freshDir() / "run").string());
   EXPECT_NE(alone.exitCode, 0);
   EXPECT_NE(alone.output.find("--lod"), std::string::npos) << alone.output;

@@ -384,6 +384,9 @@ void Cape::setOrigin(const Eigen::Vector3d& origin) {
   if (!ok() || !origin.allFinite()) return;
   if (origin == origin_) return;
   wake();
+  // The coarse level's frame is this cape's: it moves the same way (a stale one takes the origin when it
+  // starts again).
+  if (coarse_ && !coarse_->stale) coarse_->cape.setOrigin(origin);
   // Frame coordinates change by old - new, computed in double and rounded once.
   const Vec3 d = (origin_ - origin).cast<float>();
   origin_ = origin;
@@ -395,7 +398,6 @@ void Cape::setOrigin(const Eigen::Vector3d& origin) {
     p.target += d;
   }
   reference_.position += d;
-  if (coarse_ && !coarse_->stale) coarse_->cape.setOrigin(origin);
 }
 
 void Cape::relocate(const Eigen::Vector3d& origin) {
