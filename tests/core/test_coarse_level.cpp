@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 namespace cape {
@@ -203,6 +204,27 @@ TEST(CoarseFabric, AMovedFrameKeepsTheCoarseLevelWhereItIs) {
   EXPECT_TRUE(moved.cape.steppedCoarse());
   const Points world = moved.cape.state().positions.rowwise() - shift.transpose();
   EXPECT_LT(largestDifference(world, still.cape.state().positions), 1e-4f);
+}
+
+TEST(CoarseFabric, ANaNInTheStateOutlivesNoStep) {
+  // A particle made NaN (or thrown 1e30 m away) while the coarse level is on: the coarse cape starts again
+  // from the state, its numerical guard restores what it sampled from the lost particle, and the cape it
+  // drives is finite after that very step, its guard report saying so.
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), 1e30f}) {
+    Hanging h(walkSettings());
+    ASSERT_TRUE(h.cape.setCoarseLevel(true).ok());
+    h.frames(10);
+    h.cape.mutableState().positions.row(210).setConstant(bad);
+    h.cape.mutableState().velocities.row(45).setConstant(bad);
+    h.frames(1);
+    EXPECT_TRUE(h.cape.steppedCoarse());
+    EXPECT_TRUE(h.cape.state().positions.allFinite()) << bad;
+    EXPECT_TRUE(h.cape.state().velocities.allFinite()) << bad;
+    EXPECT_GT(h.cape.guard().lastStep, 0u) << bad;
+    h.frames(30);
+    EXPECT_TRUE(h.cape.state().positions.allFinite()) << bad;
+    EXPECT_EQ(largestPinError(h.cape), 0.0f);
+  }
 }
 
 TEST(CoarseFabric, PerParticleMapsKeepTheCapeOnItsOwnFabric) {

@@ -129,6 +129,15 @@ void Cape::restrictToCoarse() {
               level.offset);
   level.offset = state_.positions - level.offset;
   level.blend = 1.0f;
+  // A particle lost before the switch (not finite, or farther from the coarse cape than the fabric is
+  // wide: no fold of it) is no detail to keep: it takes the coarse cape's place at once, and the numerical
+  // guard's report counts it (the coarse cape's guard restores what was sampled from it).
+  const float limit2 = fabric_->restDiameter() * fabric_->restDiameter();
+  for (Eigen::Index i = 0; i < level.offset.rows(); ++i) {
+    if (level.offset.row(i).squaredNorm() <= limit2) continue;  // false for NaN
+    level.offset.row(i).setZero();
+    ++level.restored;
+  }
 }
 
 void Cape::rebuildCoarsePins() {
@@ -231,7 +240,8 @@ void Cape::stepCoarse(float dt, ColliderSpan colliders) {
   state_.time += static_cast<double>(dt);
   asleep_ = c.asleep_;
   if (!moved) ++sleptSteps_;
-  guard_.lastStep = c.guard_.lastStep;
+  guard_.lastStep = c.guard_.lastStep + level.restored;
+  level.restored = 0;
   if (guard_.lastStep > 0) {
     guard_.total += guard_.lastStep;
     ++guard_.steps;

@@ -47,7 +47,8 @@ struct Cape::CoarseLevel {
   std::vector<std::int32_t> nodePin;           ///< Per coarse particle: its pin's index, or -1.
   std::vector<float> nodeShare;                ///< Per coarse particle: fine pins taken by nearness.
   Eigen::VectorXf along;                       ///< interpolate()'s first pass (sized once).
-  Points offset;          ///< The fine detail at the switch: fine less interpolated coarse, m.
+  Points offset;               ///< The fine detail at the switch: fine less interpolated coarse, m.
+  std::uint32_t restored = 0;  ///< Fine particles found lost at the last switch (for the guard's report).
   float blend = 0.0f;     ///< How much of `offset` the fine particles still show (1 at the switch, then 0).
   bool stale = true;      ///< Sample the fine state before the next coarse step.
   bool pinsStale = true;  ///< Rebuild the coarse pins from the fine pins before the next coarse step.
