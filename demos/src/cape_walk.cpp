@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
       "bad command line.");
   SceneCli sceneCli;
   std::string solver = "xpbd", out;
-  int threads = 1, substeps = -1;
+  int threads = 1, substeps = -1, maxRefinement = -1;
   std::int64_t framesEvery = 1;
   bool writeFrames = false, noFrames = false, noRender = false, selfCollision = false;
   addSceneOptions(app, sceneCli);
@@ -93,6 +93,12 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"xpbd", "explicit"}))
       ->capture_default_str();
   app.add_option("--substeps", substeps, "solver substeps per 1/60 s frame (default: the solver's)")
+      ->transform(strictInteger(1, 64));
+  app.add_option(
+         "--max-refinement", maxRefinement,
+         "strain-adaptive substepping's ceiling: while the cape's largest structural strain is above 5 %, "
+         "up to N times the substeps (default: the solver's, 4; 1: never refine; a 64 x 64 cape in a "
+         "sprint needs 16 to stay within 10 %, docs/PERFORMANCE.md)")
       ->transform(strictInteger(1, 64));
   bool noSelfCollision = false;
   app.add_flag("--self-collision", selfCollision,
@@ -219,6 +225,7 @@ int main(int argc, char** argv) {
     o.settings.shearStiffness = 40.0f;
   }
   if (substeps > 0) o.settings.substeps = substeps;
+  if (maxRefinement > 0) o.settings.maxRefinement = maxRefinement;
   // The folding cape collides with itself unless told not to; the canonical one only when asked.
   o.settings.selfCollision = selfCollision || (!noSelfCollision && o.capeStyle == "cape");
   if (Status s = o.settings.validate(); !s.ok()) {

@@ -161,6 +161,27 @@ TEST(CapeWalk, CrowdResultsDoNotDependOnTheThreadCount) {
   EXPECT_EQ(strain[0], strain[1]);
 }
 
+TEST(CapeWalk, MaxRefinementBoundsTheSprintTurnsStretch) {
+  // --max-refinement is strain-adaptive substepping's ceiling (CapeSettings::maxRefinement): a 32 x 32 cape
+  // in the sprint-turn stretches most with none (1), less with the default (4), least with 16.
+  const fs::path dir = freshDir();
+  std::vector<double> p95;
+  for (int ceiling : {1, 4, 16}) {
+    const fs::path out = dir / ("r" + std::to_string(ceiling));
+    const Result r = run(kWalk + " --scene sprint-turn --simple-body --size 32 --seconds 2.5 --no-render" +
+                         " --max-refinement " + std::to_string(ceiling) + " --out " + out.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::ifstream in(out / "summary.json");
+    const json s = json::parse(in);
+    EXPECT_EQ(s["settings"]["max_refinement"].get<int>(), ceiling);
+    EXPECT_FALSE(s["summary"]["blow_up"].get<bool>());
+    p95.push_back(s["summary"]["p95_frame_max_strain"].get<double>());
+  }
+  EXPECT_GT(p95[0], 1.5 * p95[1]);
+  EXPECT_GT(p95[1], 1.5 * p95[2]);
+  EXPECT_LT(p95[2], 0.10) << "a ceiling of 16 keeps this cape within 10 %";
+}
+
 TEST(CapeWalk, CrowdWritesFramesPerCharacter) {
   const fs::path dir = freshDir();
   const Result r =

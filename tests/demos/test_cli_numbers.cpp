@@ -132,6 +132,8 @@ TEST(CliNumbers, EveryBadNumberIsRefusedBeforeAnythingIsWritten) {
       {"--frames-every 1.5", "--frames-every: '1.5' is not a whole number"},
       {"--threads 1e1", "--threads: '1e1' is not a whole number; give a whole number from 1 to 256"},
       {"--substeps 65", "--substeps: '65' is out of range; give a whole number from 1 to 64"},
+      {"--max-refinement 0", "--max-refinement: '0' is out of range; give a whole number from 1 to 64"},
+      {"--max-refinement 2.5", "--max-refinement: '2.5' is not a whole number"},
   };
   const std::vector<Case> compareOnly = {
       {"--softbody-iterations 0",
