@@ -4,6 +4,7 @@
 // scales with N); BM_WalkFrameAdaptive uses the default strain-adaptive substepping, which refines larger
 // capes (more rows for one Gauss-Seidel pass to carry) to hold the strain under 5 %. Reported: time per frame
 // and particles per second.
+#include "cape/core/FabricPresets.h"
 #include "cape/core/Simd.h"
 #include "cape/scenes/Scene.h"
 
@@ -74,6 +75,12 @@ void BM_WalkFrameSimd(benchmark::State& state) {
   runFrames(state, SceneKind::Walk, fixedSubsteps());
   (void)setSimdLevel(before);
 }
+// The walk in wool (FabricPresets.h), as cape_walk's default cape is: the linear bending hinges on, the bend
+// springs off; fixed substeps. The material at the grid's mean spacing (the scene's cape is 0.6 x 1 m).
+void BM_WalkFrameWool(benchmark::State& state) {
+  const float spacing = 0.8f / static_cast<float>(state.range(0) - 1);
+  runFrames(state, SceneKind::Walk, applyFabric(*findFabric("wool"), spacing, fixedSubsteps()));
+}
 // Self-collision on (issue 6: at most twice the step without it), the walk and the sprint-turn.
 void BM_WalkFrameSelfCollision(benchmark::State& state) {
   CapeSettings s = fixedSubsteps();
@@ -131,6 +138,7 @@ BENCHMARK(BM_HangSettled)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrame)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrameAdaptive)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WalkFrameWool)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrame4Substeps)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrameSimd)
     ->ArgNames({"n", "avx2"})

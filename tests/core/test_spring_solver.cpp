@@ -1,7 +1,7 @@
 // The constraint kernels alone (plugin/core/src/SpringSolver.h): the fabric's spring runs are a valid plan
 // (every spring once, in order; every block of four inside one colour, its indices following its layout),
-// and the vector paths give the scalar loops' bits, springs and tethers, with pinned, coincident and
-// non-finite particles among them.
+// and the vector paths give the scalar loops' bits, springs, tethers and bending hinges (whose levels keep
+// the build's order), with pinned, coincident and non-finite particles among them.
 #include "SpringSolver.h"
 
 #include "cape/core/Simd.h"
@@ -353,6 +353,83 @@ TEST(Tethers, VectorPathGivesTheScalarLoopsBits) {
       EXPECT_GT(moved, 0u);
     }
   });
+}
+
+TEST(Hinges, LevelsShareNoParticleAndKeepTheBuildOrderAtEveryParticle) {
+  for (const FabricPtr& fabric : fabrics()) {
+    ASSERT_TRUE(fabric);
+    const HingeSet& h = fabric->hinges();
+    ASSERT_GT(h.size(), 0u);
+    ASSERT_GE(h.levelStart.size(), 2u);
+    EXPECT_EQ(h.levelStart.front(), 0u);
+    EXPECT_EQ(h.levelStart.back(), h.size());
+    std::vector<std::size_t> seenInLevel(fabric->particleCount(), h.size());
+    for (std::size_t c = 0; c + 1 < h.levelStart.size(); ++c) {
+      ASSERT_LT(h.levelStart[c], h.levelStart[c + 1]) << "empty level " << c;
+      for (std::size_t k = h.levelStart[c]; k < h.levelStart[c + 1]; ++k) {
+        for (const std::uint32_t p : {h.first[k], h.middle[k], h.second[k]}) {
+          EXPECT_NE(seenInLevel[p], c) << "particle " << p << " twice in level " << c;
+          seenInLevel[p] = c;
+        }
+      }
+    }
+    // The build goes particle after particle (the hinges through each middle in turn), so every two hinges
+    // that share a particle are in the order of their middles, as the build made them.
+    std::vector<std::uint32_t> lastMiddle(fabric->particleCount(), 0);
+    for (std::size_t k = 0; k < h.size(); ++k) {
+      for (const std::uint32_t p : {h.first[k], h.middle[k], h.second[k]}) {
+        EXPECT_LE(lastMiddle[p], h.middle[k]) << "hinge " << k << " at particle " << p;
+        lastMiddle[p] = h.middle[k];
+      }
+    }
+  }
+  // The seed's 20 x 20 grid: levels wide enough that most hinges go four at a time.
+  const FabricPtr grid = makeGrid(20, 20);
+  const HingeSet& h = grid->hinges();
+  std::size_t inBlocks = 0;
+  for (std::size_t c = 0; c + 1 < h.levelStart.size(); ++c)
+    inBlocks += (h.levelStart[c + 1] - h.levelStart[c]) / 4 * 4;
+  EXPECT_GT(inBlocks, h.size() * 3 / 4) << inBlocks << " of " << h.size();
+}
+
+TEST(Hinges, FourAtATimeGiveTheScalarLoopsBits) {
+  for (const FabricPtr& fabric : fabrics()) {
+    ASSERT_TRUE(fabric);
+    const HingeSet& h = fabric->hinges();
+    for (const bool keepLambda : {false, true}) {
+      for (const bool scaled : {false, true}) {
+        SCOPED_TRACE(::testing::Message() << "lambda " << keepLambda << ", scaled " << scaled);
+        KernelState vector = jittered(*fabric, 23);
+        vector.w[1] = 0.0f;  // with particle 0: a clamp at every hinge with middle 1 and one arm on 0
+        std::vector<float> lambda(h.size(), 0.0f), scale(h.size(), 1.0f);
+        std::mt19937 rng(5);
+        std::uniform_real_distribution<float> u(0.5f, 2.0f);
+        for (std::size_t k = 0; k < h.size(); ++k) {
+          lambda[k] = keepLambda ? 1e-3f * u(rng) : 0.0f;
+          scale[k] = u(rng);
+        }
+        const KernelState before = vector;
+        KernelState scalar = vector;
+        std::vector<float> lambdaScalar = lambda;
+        const float* s = scaled ? scale.data() : nullptr;
+        const float rigidity = 2e-4f, invH2 = 240.0f * 240.0f;
+        for (int pass = 0; pass < 3; ++pass) {
+          detail::solveHinges(vector.x.data(), vector.y.data(), vector.z.data(), vector.w.data(), h, rigidity,
+                              invH2, keepLambda ? lambda.data() : nullptr, s);
+          detail::solveHingesScalar(scalar.x.data(), scalar.y.data(), scalar.z.data(), scalar.w.data(), h,
+                                    rigidity, invH2, keepLambda ? lambdaScalar.data() : nullptr, s, 0,
+                                    h.size());
+        }
+        EXPECT_TRUE(sameBits(vector.x, scalar.x));
+        EXPECT_TRUE(sameBits(vector.y, scalar.y));
+        EXPECT_TRUE(sameBits(vector.z, scalar.z));
+        EXPECT_TRUE(sameBits(lambda, lambdaScalar));
+        EXPECT_FALSE(sameBits(vector.z, before.z));  // the hinges did bend the jittered cloth back
+        EXPECT_EQ(vector.x[0], before.x[0]);         // pinned particles stay
+        EXPECT_EQ(vector.x[1], before.x[1]);
+      }
+    }
+  }
 }
 
 }  // namespace

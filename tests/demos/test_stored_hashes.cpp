@@ -1,8 +1,9 @@
 // Stored determinism hashes of the Bullet walk, as cape_walk runs it: the shipped humanoid and the simple
 // body, each wearing the canonical cape (--cape canonical: docs/SCENES.md's 20 x 20 cape pinned by its
 // corners), stepped by stepSimulation(1/60, 8, 1/240) for 2 s, in the walk and, with self-collision (which
-// the walk never needs), the sprint-turn's first turn. The whole path is in them: the character, the
-// adapter's discovery, pins and collider conversion, and the core step. A change of behaviour on purpose
+// the walk never needs), the sprint-turn's first turn; and the humanoid in cape_walk's default cape (wool on
+// a gathered collar: the bending hinges, self-collision) in both. The whole path is in them: the character,
+// the adapter's discovery, pins and collider conversion, and the core step. A change of behaviour on purpose
 // updates the table in the same commit, saying why.
 #include "DemoTestSupport.h"
 
@@ -25,6 +26,8 @@ constexpr StoredRun kStored[] = {
     {"--cape canonical --scene sprint-turn --self-collision", "219d452d1fb3c51d"},
     {"--cape canonical --simple-body --scene walk", "7e841931b51c1c66"},
     {"--cape canonical --simple-body --scene sprint-turn --self-collision", "dfcf10d4c7748c1b"},
+    {"--scene walk", "c4808c6d5dfaaad7"},
+    {"--scene sprint-turn", "05dd32c520eb0386"},
 };
 #else
 constexpr StoredRun kStored[] = {
@@ -32,6 +35,8 @@ constexpr StoredRun kStored[] = {
     {"--cape canonical --scene sprint-turn --self-collision", "d80ddd74e7b20a8c"},
     {"--cape canonical --simple-body --scene walk", "5107e3ce3bf11888"},
     {"--cape canonical --simple-body --scene sprint-turn --self-collision", "7f31809400315d25"},
+    {"--scene walk", "cb35777365341713"},
+    {"--scene sprint-turn", "3415373131e18145"},
 };
 #endif
 

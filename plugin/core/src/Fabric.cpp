@@ -495,6 +495,43 @@ void Fabric::buildHinges() {
       hinges_.areaOverLength2.push_back(static_cast<float>(share / (mean * mean)));
     }
   }
+  scheduleHinges();
+}
+
+void Fabric::scheduleHinges() {
+  // Level scheduling of the Gauss-Seidel sweep (the build order: particle after particle, a grid's row-major
+  // sweep): a hinge's level is one past the highest level of the earlier hinges it shares a particle with.
+  // Hinges of one level share no particle, and every two hinges that do keep their order, so solving level
+  // after level gives the build order's bits exactly while the hinges of a level run side by side.
+  const std::size_t count = hinges_.size();
+  std::vector<std::uint32_t> levelOf(count);
+  std::vector<std::uint32_t> next(particleCount(), 0);  // the lowest level still free at each particle
+  std::uint32_t levels = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::uint32_t ends[3] = {hinges_.first[k], hinges_.middle[k], hinges_.second[k]};
+    const std::uint32_t level = std::max({next[ends[0]], next[ends[1]], next[ends[2]]});
+    for (const std::uint32_t e : ends) next[e] = level + 1;
+    levelOf[k] = level;
+    levels = std::max(levels, level + 1);
+  }
+  std::vector<std::size_t> order(count);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t l, std::size_t r) { return levelOf[l] < levelOf[r]; });
+  HingeSet sorted;
+  sorted.levelStart.assign(levels + 1, 0);
+  for (const std::size_t k : order) {
+    sorted.first.push_back(hinges_.first[k]);
+    sorted.middle.push_back(hinges_.middle[k]);
+    sorted.second.push_back(hinges_.second[k]);
+    sorted.firstWeight.push_back(hinges_.firstWeight[k]);
+    sorted.secondWeight.push_back(hinges_.secondWeight[k]);
+    sorted.restBend.push_back(hinges_.restBend[k]);
+    sorted.areaOverLength2.push_back(hinges_.areaOverLength2[k]);
+    ++sorted.levelStart[levelOf[k] + 1];
+  }
+  for (std::uint32_t c = 0; c < levels; ++c) sorted.levelStart[c + 1] += sorted.levelStart[c];
+  hinges_ = std::move(sorted);
 }
 
 void Fabric::buildComponents() {

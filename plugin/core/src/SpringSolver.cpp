@@ -558,9 +558,10 @@ inline HingeGeometry hingeGeometry(const float* px, const float* py, const float
 
 }  // namespace
 
-void solveHinges(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
-                 float bendingRigidity, float invH2, float* lambda, const float* stiffnessScale) {
-  for (std::size_t k = 0; k < hinges.size(); ++k) {
+void solveHingesScalar(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
+                       float bendingRigidity, float invH2, float* lambda, const float* stiffnessScale,
+                       std::size_t begin, std::size_t end) {
+  for (std::size_t k = begin; k < end; ++k) {
     const HingeGeometry g = hingeGeometry(px, py, pz, hinges, k);
     if (!(g.length > 1e-12f) || !std::isfinite(g.length)) continue;
     const std::uint32_t i = hinges.first[k], j = hinges.middle[k], l = hinges.second[k];
@@ -589,6 +590,105 @@ void solveHinges(float* px, float* py, float* pz, const float* inverseMass, cons
     pz[j] -= wj * ab * nz;
   }
 }
+
+#if defined(__SSE2__)
+
+namespace {
+
+// solveHingesScalar's body for hinges [k, k + 4) of one level (they share no particle), lane for lane the
+// same operations in the same order; a lane the scalar loop would skip keeps its particles' values (selects).
+inline void hingeBlock(float* px, float* py, float* pz, const float* w, const HingeSet& h,
+                       __m128 bendingRigidity, __m128 invH2, float* lambda, const float* stiffnessScale,
+                       std::size_t k) {
+  const std::uint32_t* i = h.first.data() + k;
+  const std::uint32_t* j = h.middle.data() + k;
+  const std::uint32_t* l = h.second.data() + k;
+  const auto gather = [](const float* x, const std::uint32_t* index) {
+    return _mm_setr_ps(x[index[0]], x[index[1]], x[index[2]], x[index[3]]);
+  };
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
+  const __m128 xi = gather(px, i), xj = gather(px, j), xl = gather(px, l);
+  const __m128 yi = gather(py, i), yj = gather(py, j), yl = gather(py, l);
+  const __m128 zi = gather(pz, i), zj = gather(pz, j), zl = gather(pz, l);
+  const __m128 a = _mm_loadu_ps(h.firstWeight.data() + k), b = _mm_loadu_ps(h.secondWeight.data() + k);
+  const __m128 ab = _mm_add_ps(a, b);
+  const __m128 dx = _mm_add_ps(_mm_mul_ps(a, _mm_sub_ps(xi, xj)), _mm_mul_ps(b, _mm_sub_ps(xl, xj)));
+  const __m128 dy = _mm_add_ps(_mm_mul_ps(a, _mm_sub_ps(yi, yj)), _mm_mul_ps(b, _mm_sub_ps(yl, yj)));
+  const __m128 dz = _mm_add_ps(_mm_mul_ps(a, _mm_sub_ps(zi, zj)), _mm_mul_ps(b, _mm_sub_ps(zl, zj)));
+  const __m128 length =
+      _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)));
+  const __m128 c = _mm_sub_ps(length, _mm_loadu_ps(h.restBend.data() + k));
+  const __m128 wi = gather(w, i), wj = gather(w, j), wl = gather(w, l);
+  const __m128 clamped =
+      _mm_and_ps(_mm_cmpeq_ps(wj, zero), _mm_xor_ps(_mm_cmpeq_ps(wi, zero), _mm_cmpeq_ps(wl, zero)));
+  const __m128 clamp = select(clamped, two, one);
+  const __m128 scale = stiffnessScale != nullptr ? _mm_loadu_ps(stiffnessScale + k) : one;
+  const __m128 alphaTilde =
+      _mm_div_ps(invH2, _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(clamp, scale), bendingRigidity),
+                                   _mm_loadu_ps(h.areaOverLength2.data() + k)));
+  const __m128 denominator =
+      _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_mul_ps(wi, a), a), _mm_mul_ps(_mm_mul_ps(wl, b), b)),
+                            _mm_mul_ps(_mm_mul_ps(wj, ab), ab)),
+                 alphaTilde);
+  // Solved where 1e-12 < |d| <= FLT_MAX (false for NaN) and the denominator is positive (false for NaN).
+  const __m128 active =
+      _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(length, _mm_set1_ps(1e-12f)),
+                            _mm_cmple_ps(length, _mm_set1_ps(std::numeric_limits<float>::max()))),
+                 _mm_cmpgt_ps(denominator, zero));
+  const __m128 previous = lambda != nullptr ? _mm_loadu_ps(lambda + k) : zero;
+  const __m128 dLambda = _mm_div_ps(
+      _mm_sub_ps(_mm_xor_ps(c, _mm_set1_ps(-0.0f)), _mm_mul_ps(alphaTilde, previous)), denominator);
+  if (lambda != nullptr) _mm_storeu_ps(lambda + k, select(active, _mm_add_ps(previous, dLambda), previous));
+  const __m128 s = _mm_div_ps(dLambda, length);
+  const __m128 nx = _mm_mul_ps(dx, s), ny = _mm_mul_ps(dy, s), nz = _mm_mul_ps(dz, s);
+  const __m128 wia = _mm_mul_ps(wi, a), wlb = _mm_mul_ps(wl, b), wjab = _mm_mul_ps(wj, ab);
+  alignas(16) float out[9][4];
+  _mm_store_ps(out[0], select(active, _mm_add_ps(xi, _mm_mul_ps(wia, nx)), xi));
+  _mm_store_ps(out[1], select(active, _mm_add_ps(yi, _mm_mul_ps(wia, ny)), yi));
+  _mm_store_ps(out[2], select(active, _mm_add_ps(zi, _mm_mul_ps(wia, nz)), zi));
+  _mm_store_ps(out[3], select(active, _mm_add_ps(xl, _mm_mul_ps(wlb, nx)), xl));
+  _mm_store_ps(out[4], select(active, _mm_add_ps(yl, _mm_mul_ps(wlb, ny)), yl));
+  _mm_store_ps(out[5], select(active, _mm_add_ps(zl, _mm_mul_ps(wlb, nz)), zl));
+  _mm_store_ps(out[6], select(active, _mm_sub_ps(xj, _mm_mul_ps(wjab, nx)), xj));
+  _mm_store_ps(out[7], select(active, _mm_sub_ps(yj, _mm_mul_ps(wjab, ny)), yj));
+  _mm_store_ps(out[8], select(active, _mm_sub_ps(zj, _mm_mul_ps(wjab, nz)), zj));
+  for (int q = 0; q < 4; ++q) {
+    px[i[q]] = out[0][q];
+    py[i[q]] = out[1][q];
+    pz[i[q]] = out[2][q];
+    px[l[q]] = out[3][q];
+    py[l[q]] = out[4][q];
+    pz[l[q]] = out[5][q];
+    px[j[q]] = out[6][q];
+    py[j[q]] = out[7][q];
+    pz[j[q]] = out[8][q];
+  }
+}
+
+}  // namespace
+
+void solveHinges(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
+                 float bendingRigidity, float invH2, float* lambda, const float* stiffnessScale) {
+  const __m128 rigidity = _mm_set1_ps(bendingRigidity), inverseH2 = _mm_set1_ps(invH2);
+  for (std::size_t c = 0; c + 1 < hinges.levelStart.size(); ++c) {
+    std::size_t k = hinges.levelStart[c];
+    const std::size_t end = hinges.levelStart[c + 1];
+    for (; k + 4 <= end; k += 4)
+      hingeBlock(px, py, pz, inverseMass, hinges, rigidity, inverseH2, lambda, stiffnessScale, k);
+    solveHingesScalar(px, py, pz, inverseMass, hinges, bendingRigidity, invH2, lambda, stiffnessScale, k,
+                      end);
+  }
+}
+
+#else
+
+void solveHinges(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
+                 float bendingRigidity, float invH2, float* lambda, const float* stiffnessScale) {
+  solveHingesScalar(px, py, pz, inverseMass, hinges, bendingRigidity, invH2, lambda, stiffnessScale, 0,
+                    hinges.size());
+}
+
+#endif
 
 void addHingeForces(const float* px, const float* py, const float* pz, const float* inverseMass,
                     const HingeSet& hinges, float bendingRigidity, float* ax, float* ay, float* az,

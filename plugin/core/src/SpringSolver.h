@@ -69,11 +69,18 @@ void solveTethers(float* px, float* py, float* pz, const float* inverseMass, con
 /// hinge's curvature vector and the gradients w1 n, w2 n, -(w1 + w2) n at its first, second and middle
 /// particle (n = d / |d|, w1, w2 its arm weights), and the compliance 1 / (bendingRigidity areaOverLength2):
 ///   dlambda = (-C - alpha~ lambda) / (m1 w1^2 + m2 w2^2 + mm (w1 + w2)^2 + alpha~),
-/// with m the inverse masses; one hinge after another in the set's order. A hinge with |d| below 1e-12 (a
-/// straight line) has no direction and is left alone. `lambda` may be null, as SpringSolveArrays'.
-/// `invH2` is 1 / h^2.
+/// with m the inverse masses; one hinge after another in the set's order (level after level), four at a
+/// time within a level (SSE2 on x86-64; elsewhere one at a time): bit for bit solveHingesScalar over the
+/// whole set, since the hinges of a level share no particle and every lane does the scalar loop's operations
+/// in its order. A hinge with |d| below 1e-12 (a straight line) has no direction and is left alone. `lambda`
+/// may be null, as SpringSolveArrays'. `invH2` is 1 / h^2.
 void solveHinges(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
                  float bendingRigidity, float invH2, float* lambda, const float* stiffnessScale = nullptr);
+
+/// solveHinges' scalar loop over hinges [begin, end).
+void solveHingesScalar(float* px, float* py, float* pz, const float* inverseMass, const HingeSet& hinges,
+                       float bendingRigidity, float invH2, float* lambda, const float* stiffnessScale,
+                       std::size_t begin, std::size_t end);
 
 /// `stiffnessScale`, when not null, multiplies each hinge's stiffness (Cape::setStiffnessScale).
 ///

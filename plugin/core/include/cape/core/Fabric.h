@@ -95,6 +95,11 @@ struct HingeSet {
   /// whole for each of one or two hinges (a grid's row and column, exact along them; on the bias a grid is
   /// half as stiff), 8 / (3 n) of it for each of n >= 3 (exact in every direction on an equilateral mesh).
   std::vector<float> areaOverLength2;
+  /// Offsets of each level, plus the end. The build sorts the hinges into levels of its own order (a
+  /// hinge's level is one past the highest of the earlier hinges it shares a particle with): the hinges of
+  /// one level share no particle, so the solver takes four of them at a time, and solving level after level
+  /// is solving the build's order (particle after particle) bit for bit.
+  std::vector<std::uint32_t> levelStart;
   /// The number of hinges.
   std::size_t size() const { return first.size(); }
 };
@@ -242,6 +247,7 @@ class CAPE_CORE_API Fabric {
   void buildTriangleTables();
   void buildComponents();
   void buildHinges();
+  void scheduleHinges();
 
   float meanSpacing_ = 0.0f;
   Eigen::VectorXf particleAreas_;
