@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 
 namespace cape::character {
 namespace {
@@ -21,10 +22,19 @@ bool haveModels() {
   return fs::exists(kModels + "OBJ/cube_with_vertexcolors.obj");
 }
 
+/// This process's folder of written inputs, removed when the process ends.
+struct InputFolder {
+  fs::path path = fs::temp_directory_path() / ("cape_fabric_mesh_" + std::to_string(::getpid()));
+  ~InputFolder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
 fs::path writeFile(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / ("cape_fabric_mesh_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const fs::path file = dir / name;
+  static const InputFolder dir;
+  fs::create_directories(dir.path);
+  const fs::path file = dir.path / name;
   std::ofstream(file) << text;
   return file;
 }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace cape::demo_test {
@@ -31,13 +32,38 @@ inline Result run(const std::string& command) {
   return r;
 }
 
-/// A fresh, empty folder under the temporary directory, named after the running test and this process (two
-/// test runs at once on one machine must not share it).
+/// This process's folder under the temporary directory, named after the process (two test runs at once on
+/// one machine must not share it), which holds one fresh folder per test. Removed when the process ends,
+/// unless a test failed: then what the demos wrote is kept, and the path is printed.
+class ProcessFolder {
+ public:
+  static const std::filesystem::path& path() {
+    // Made on the first use in a test, after GoogleTest's own UnitTest: destroyed before it.
+    static ProcessFolder folder;
+    return folder.path_;
+  }
+  ProcessFolder(const ProcessFolder&) = delete;
+  ProcessFolder& operator=(const ProcessFolder&) = delete;
+
+ private:
+  ProcessFolder()
+      : path_(std::filesystem::temp_directory_path() / ("cape_demo_tests-" + std::to_string(::getpid()))) {}
+  ~ProcessFolder() {
+    if (::testing::UnitTest::GetInstance()->Failed()) {
+      std::fprintf(stderr, "the demos' outputs are kept in %s\n", path_.c_str());
+      return;
+    }
+    std::error_code ignored;  // nothing to report at exit: a folder left behind is only untidy
+    std::filesystem::remove_all(path_, ignored);
+  }
+  std::filesystem::path path_;
+};
+
+/// A fresh, empty folder in this process's folder (ProcessFolder), named after the running test.
 inline std::filesystem::path freshDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::filesystem::path dir = std::filesystem::temp_directory_path() /
-                              ("cape_demo_tests-" + std::to_string(::getpid())) /
-                              (std::string(info->test_suite_name()) + "." + info->name());
+  std::filesystem::path dir =
+      ProcessFolder::path() / (std::string(info->test_suite_name()) + "." + info->name());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
