@@ -1,6 +1,7 @@
 // Self-collision: predictive particle-triangle contacts keep a fast layer of cloth from passing through
 // another, and switching them off leaves the solver exactly as it was.
 #include "CapeTestFixture.h"
+#include "SelfCollision.h"
 
 #include "cape/core/Geometry.h"
 #include "cape/scenes/Metrics.h"
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <random>
 #include <set>
 #include <utility>
 
@@ -246,6 +248,48 @@ TEST(SelfCollision, AFastFrameIsSearchedEveryFewSubsteps) {
   TwoLayers calm(true, 0.5f);
   calm.cape->step(1.0f / 60.0f, {});
   EXPECT_EQ(calm.cape->selfContactSearches(), 1u);
+}
+
+TEST(SelfCollision, APairToldBesideAndApartIsOneTheSolveLeavesAsItIs) {
+  // The solve's shortcut (detail::besideAndApart) against the full test it stands for: wherever it says
+  // yes, the particle is not over the grown face by the solve's own weights, and the nearest point of the
+  // triangle is at least the thickness away. Triangles of every shape (slivers too) and scale, particles
+  // around them and far off.
+  using detail::besideAndApart;
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(1, 1, 0);
+  EXPECT_TRUE(besideAndApart(Vec3(-1, 0, 0), a, b, c, 0.35f));  // the 2-ring of a flat grid
+  EXPECT_TRUE(besideAndApart(Vec3(2, 2, 0.1f), a, b, c, 0.35f));
+  EXPECT_FALSE(besideAndApart(Vec3(0.6f, 0.2f, 0.5f), a, b, c, 0.35f));   // over the face
+  EXPECT_FALSE(besideAndApart(Vec3(-0.2f, 0.0f, 0.0f), a, b, c, 0.35f));  // beside, within the thickness
+  EXPECT_FALSE(besideAndApart(Vec3(1.2f, 0.5f, 0.0f), a, b, c, 0.35f));   // over the grown face's margin
+
+  std::mt19937 rng(20261206);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f), fraction(0.0f, 1.0f);
+  int told = 0, cases = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const float scale = std::pow(10.0f, 4.0f * fraction(rng) - 3.0f);  // 1 mm to 10 m
+    const Vec3 origin = Vec3(unit(rng), unit(rng), unit(rng)) * 100.0f * fraction(rng);
+    Vec3 corner[3];
+    for (Vec3& k : corner) k = origin + scale * Vec3(unit(rng), unit(rng), unit(rng));
+    if (i % 4 == 0)
+      corner[2] = corner[0] + fraction(rng) * (corner[1] - corner[0]) +
+                  1e-3f * scale * Vec3(unit(rng), unit(rng), unit(rng));  // a sliver
+    const Vec3 p = origin + (i % 3 == 0 ? 8.0f : 2.0f) * scale * Vec3(unit(rng), unit(rng), unit(rng));
+    const float thickness = scale * (0.05f + fraction(rng));
+    ++cases;
+    if (!besideAndApart(p, corner[0], corner[1], corner[2], thickness)) continue;
+    ++told;
+    float wa = 0, wb = 0, wc = 0;
+    if (detail::planeBarycentric(p, corner[0], corner[1], corner[2], wa, wb, wc)) {
+      ASSERT_TRUE(wa < -detail::kFaceMargin || wb < -detail::kFaceMargin || wc < -detail::kFaceMargin)
+          << "case " << i << ": over the grown face (" << wa << ", " << wb << ", " << wc << ")";
+    }
+    const TriangleNearest w = nearestOnTriangle(p, corner[0], corner[1], corner[2]);
+    const Vec3 nearest = w.wa * corner[0] + w.wb * corner[1] + w.wc * corner[2];
+    ASSERT_GE((p - nearest).norm(), thickness) << "case " << i;
+  }
+  // It does tell most of such pairs: a shortcut that never said yes would pass the checks above.
+  EXPECT_GT(told, cases / 10) << told << " of " << cases;
 }
 
 TEST(SelfCollision, SwitchedOffTheSolverIsBitForBitUnchanged) {

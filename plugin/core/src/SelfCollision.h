@@ -10,6 +10,20 @@
 
 namespace cape::detail {
 
+/// Barycentric weights of p's projection onto the plane of (a, b, c), unclamped; false if degenerate.
+bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float& wa, float& wb,
+                      float& wc);
+/// A particle over a triangle grown by this fraction of itself (in barycentric terms) keeps its side: the
+/// grown triangles of a vertex's ring overlap, so a particle heading straight for a vertex or an edge of the
+/// other layer (two halves of a folded grid line up exactly) is caught as surely as one heading for a face.
+inline constexpr float kFaceMargin = 0.25f;
+
+/// Whether p is beside triangle (a, b, c) and at least `thickness` from it, told without its nearest point:
+/// then SelfCollision::solve leaves the pair as it is (p neither over the face grown by kFaceMargin, where
+/// the solve would note its side, nor within the thickness). false where it cannot tell, and the full test
+/// decides.
+bool besideAndApart(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float thickness);
+
 class SelfCollision {
  public:
   explicit SelfCollision(const Fabric& fabric);
