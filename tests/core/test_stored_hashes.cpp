@@ -27,7 +27,7 @@ constexpr StoredScene kStored[] = {
     {SceneKind::Walk, false, 0x5faab71c43d1e6baull},
     {SceneKind::Walk, true, 0x5faab71c43d1e6baull},
     {SceneKind::SprintTurn, false, 0xa2b1ed84dc23402aull},
-    {SceneKind::SprintTurn, true, 0x7f9634af2be8b8d2ull},
+    {SceneKind::SprintTurn, true, 0x98b200c28124e571ull},
     {SceneKind::Wind, false, 0x7132717a08c6698aull},
     {SceneKind::Wind, true, 0x6fafb93a52a5ffc7ull},
 };

@@ -58,7 +58,7 @@ class SelfCollision {
   void find(const Points& x, const Points& v, float thickness);
   /// Bins every cluster's grown box into the hash (find's first half).
   void bin();
-  /// Particle q (at p, its motion's box qlo..qhi) against one bucket's clusters.
+  /// Particle q (at p, its swept box qlo..qhi) against one bucket's clusters.
   void scanBucket(std::uint32_t q, const Vec3& p, const float* qlo, const float* qhi, std::uint32_t bucket,
                   bool stamp);
   /// Particle q against triangle t: the exact filter, and the contact if within reach.
