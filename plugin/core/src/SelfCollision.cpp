@@ -197,6 +197,8 @@ SelfCollision::SelfCollision(const Fabric& fabric) : fabric_(fabric) {
   clusterBoxes_.assign(6 * fabric.clusterCount(), 0.0f);
   clusterBucketStart_.assign(fabric.clusterCount() + 1, 0u);
   stepMotion_ = Points::Zero(static_cast<Eigen::Index>(n), 3);
+  sweptLo_ = Points::Zero(static_cast<Eigen::Index>(n), 3);
+  sweptHi_ = Points::Zero(static_cast<Eigen::Index>(n), 3);
   stepMotionNorm_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(n));
   contacts_.reserve(32 * n);
 }
@@ -312,19 +314,14 @@ void SelfCollision::grownBox(std::uint32_t t, Vec3& lo, Vec3& hi) const {
   // thickness of it at some moment of the window is then in this box, and the particle's own swept box
   // overlaps it. As binned, and for the rare unbinned paths.
   const std::vector<std::uint32_t>& tri = fabric_.triangles();
-  const Points& x = *x_;
-  const Points& m = stepMotion_;
-  lo = Vec3::Constant(std::numeric_limits<float>::max());
-  hi = -lo;
-  for (int k = 0; k < 3; ++k) {
-    const std::uint32_t i = tri[3 * t + static_cast<std::uint32_t>(k)];
-    const Vec3 start = at(x, i), end = start + at(m, i);
-    lo = lo.cwiseMin(start).cwiseMin(end);
-    hi = hi.cwiseMax(start).cwiseMax(end);
-  }
+  const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
   const float grow = thickness_ + slack_;
-  lo.array() -= grow;
-  hi.array() += grow;
+  for (int k = 0; k < 3; ++k) {
+    const float* l = sweptLo_.col(k).data();
+    const float* h = sweptHi_.col(k).data();
+    lo[k] = std::min({l[ia], l[ib], l[ic]}) - grow;
+    hi[k] = std::max({h[ia], h[ib], h[ic]}) + grow;
+  }
 }
 
 CAPE_ALWAYS_INLINE inline void SelfCollision::consider(std::uint32_t q, const Vec3& p, std::uint32_t t,
@@ -397,6 +394,10 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
   slack_ = 0.25f * fabric_.meanSpacing();
   invCell_ = 1.0f / (2.0f * fabric_.meanSpacing());
   mask_ = static_cast<std::uint32_t>(hashStart_.size() - 1) - 1;
+  // Each particle's swept box: from where it is to where its predicted motion takes it (the same size every
+  // search: no allocation).
+  sweptLo_ = x.cwiseMin(x + stepMotion_);
+  sweptHi_ = x.cwiseMax(x + stepMotion_);
   bin();
   // Each particle visits the cells of its own swept box. A pair that comes within reach at some moment of
   // the window (each moving by its predicted motion; the slack for what the prediction misses) is in both
@@ -409,10 +410,8 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
     const std::uint32_t q = static_cast<std::uint32_t>(qi);
     particleFirst_ = contacts_.size();
     const Vec3 p = at(x, q);
-    // The particle's swept box: from where it is to where its predicted motion takes it.
-    const Vec3 end = p + at(stepMotion_, q);
-    const float qlo[3] = {std::min(p.x(), end.x()), std::min(p.y(), end.y()), std::min(p.z(), end.z())},
-                qhi[3] = {std::max(p.x(), end.x()), std::max(p.y(), end.y()), std::max(p.z(), end.z())};
+    const float qlo[3] = {sweptLo_(qi, 0), sweptLo_(qi, 1), sweptLo_(qi, 2)},
+                qhi[3] = {sweptHi_(qi, 0), sweptHi_(qi, 1), sweptHi_(qi, 2)};
     int range[8];
     if (!cellsOf(invCell_, qlo[0], qlo[1], qlo[2], qhi[0], qhi[1], qhi[2], range)) {
       for (std::size_t t = 0; t < triangles && !particleFull(); ++t) {

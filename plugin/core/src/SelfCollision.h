@@ -91,6 +91,7 @@ class SelfCollision {
   std::vector<std::uint32_t> bucketCluster_;       ///< The last cluster binned into each bucket.
   Points stepMotion_;  ///< Predicted displacement over the search's window, less a rigid motion, m.
   Eigen::VectorXf stepMotionNorm_;  ///< |stepMotion_| per particle, m.
+  Points sweptLo_, sweptHi_;        ///< Per particle: the box from its position to its predicted one, m.
 
   // Per search: what every particle's scan reads.
   const Points* x_ = nullptr;
