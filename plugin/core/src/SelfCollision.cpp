@@ -358,24 +358,7 @@ CAPE_ALWAYS_INLINE inline void SelfCollision::consider(std::uint32_t q, const Ve
   if (d2 > reach * reach) return;
   const TriangleNearest w = nearestOnTriangle(p, a, b, c);
   const Vec3 nearest = w.wa * a + w.wb * b + w.wc * c;
-  const Vec3 apart = p - nearest;
-  const float distance2 = apart.squaredNorm();
-  if (distance2 > within * within) return;
-  // How much closer they may come along the line between them. The plane through the nearest point across
-  // that line keeps the triangle on its far side; moving with the corners' mean motion, the triangle's
-  // points stay within `spread` (its corners' motions about their mean) of it, and the particle moves
-  // towards it at its motion relative to that mean, along the line. Over the window the gap is then at
-  // least distance + min(0, relative motion . direction - spread): a pair sliding past each other, or
-  // moving apart, stays out of reach (most of a fast cape's pairs in its own sheet).
-  const float distance = std::sqrt(distance2);
-  if (distance > 0.0f) {
-    const Vec3 ma = at(stepMotion_, ia), mb = at(stepMotion_, ib), mc = at(stepMotion_, ic);
-    const Vec3 mean = (ma + mb + mc) / 3.0f;
-    const float spread = std::sqrt(
-        std::max({(ma - mean).squaredNorm(), (mb - mean).squaredNorm(), (mc - mean).squaredNorm()}));
-    const float approach = (mqv - mean).dot(apart) / distance - spread;
-    if (distance + std::min(0.0f, approach) > thickness_ + slack_) return;
-  }
+  if ((p - nearest).squaredNorm() > within * within) return;
   float side = 0.0f, wa, wb, wc;
   if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc))
     side = (b - a).cross(c - a).dot(p - a) >= 0.0f ? 1.0f : -1.0f;
