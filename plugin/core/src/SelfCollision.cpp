@@ -385,8 +385,8 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
   // Each particle visits the cells of its own swept box. A pair that comes within reach at some moment of
   // the window (each moving by its predicted motion; the slack for what the prediction misses) is in both
   // boxes then, so the boxes overlap: swept boxes keep every such pair, and drop the pairs that only a box of
-  // the motion's length in every direction kept (a cape moving fast one way: such boxes met three times as
-  // many clusters in the 64 x 64 sprint-turn).
+  // the motion's length in every direction kept (those slide past each other or part: in the 64 x 64
+  // sprint-turn such boxes met 18 clusters per particle where swept boxes meet 4.5, its own mostly).
   std::fill(triangleStamp_.begin(), triangleStamp_.end(), ~0u);
   const std::size_t triangles = fabric_.triangleCount();
   for (Eigen::Index qi = 0; qi < x.rows(); ++qi) {
