@@ -2,8 +2,10 @@
 // Contacts", GDC). At the start of a step (and every few substeps while the cape moves fast) every particle
 // that could come within the thickness of a triangle it does not belong to before the next search is paired
 // with it, and the side of the triangle it is on is noted. The substeps then keep the particle on that side,
-// at least the thickness away: as long as the cape starts free of intersections, no particle can pass
-// through a triangle, however fast the fold.
+// at least the thickness away: as long as the cape starts free of intersections, and its pairs stay within
+// the slack of their predicted motion, no particle can pass through a triangle, however fast the fold. A
+// fast turn's pairs leave their prediction by more than the slack in some windows (docs/PERFORMANCE.md,
+// "Self-contacts: swept boxes").
 #include "SelfCollision.h"
 
 #include "cape/core/Geometry.h"
