@@ -210,6 +210,165 @@ TEST(SelfCollision, AWingOfOneHalfOfACellFoldedOntoTheOtherHalfIsAContact) {
   EXPECT_TRUE(found) << "particle 4 folded onto triangle 1 is not a contact";
 }
 
+TEST(SelfCollision, ClosestPointsOfTwoSegmentsAreTheSampledMinimum) {
+  // Random segments in a unit box (some short, some nearly parallel, some crossing): the closest points'
+  // distance is the minimum over a fine sampling of both, never above it and at most the sampling's error
+  // below; `interior` exactly when both parameters are strictly inside and the segments are not parallel.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  const auto rnd = [&] { return Vec3(u(rng), u(rng), u(rng)); };
+  int interiors = 0;
+  for (int k = 0; k < 400; ++k) {
+    const Vec3 p0 = rnd(), q0 = rnd();
+    Vec3 p1 = rnd(), q1 = rnd();
+    if (k % 4 == 1) q1 = q0 + (p1 - p0) * 0.7f + Vec3::Constant(1e-5f);  // nearly parallel
+    if (k % 4 == 2) p1 = p0 + 0.01f * (p1 - p0);                         // short
+    float s = -1, t = -1;
+    bool interior = true;
+    ASSERT_TRUE(detail::closestOnSegments(p0, p1, q0, q1, s, t, interior));
+    ASSERT_GE(s, 0.0f);
+    ASSERT_LE(s, 1.0f);
+    ASSERT_GE(t, 0.0f);
+    ASSERT_LE(t, 1.0f);
+    const float found = ((p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0))).norm();
+    float sampled = std::numeric_limits<float>::max();
+    constexpr int kSamples = 400;
+    for (int i = 0; i <= kSamples; ++i)
+      for (int j = 0; j <= kSamples; ++j) {
+        const float si = static_cast<float>(i) / kSamples, tj = static_cast<float>(j) / kSamples;
+        sampled = std::min(sampled, ((p0 + si * (p1 - p0)) - (q0 + tj * (q1 - q0))).norm());
+      }
+    const float step = ((p1 - p0).norm() + (q1 - q0).norm()) / kSamples;
+    EXPECT_LE(found, sampled + 1e-4f) << "pair " << k;  // rounding, nearly parallel ones most
+    EXPECT_GE(found, sampled - step - 1e-5f) << "pair " << k;
+    if (interior) {
+      ++interiors;
+      EXPECT_GT(s, 0.0f);
+      EXPECT_LT(s, 1.0f);
+      EXPECT_GT(t, 0.0f);
+      EXPECT_LT(t, 1.0f);
+      // The gap is along the common normal.
+      const Vec3 n = (p1 - p0).cross(q1 - q0).normalized();
+      const Vec3 gap = (p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0));
+      EXPECT_NEAR(std::abs(n.dot(gap)), gap.norm(), 1e-4f) << "pair " << k;
+    }
+  }
+  EXPECT_GT(interiors, 20);
+  // Crossing segments meet; a degenerate one has no closest points.
+  float s, t;
+  bool interior;
+  ASSERT_TRUE(detail::closestOnSegments(Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0), s, t,
+                                        interior));
+  EXPECT_TRUE(interior);
+  EXPECT_FLOAT_EQ(s, 0.5f);
+  EXPECT_FLOAT_EQ(t, 0.5f);
+  EXPECT_FALSE(
+      detail::closestOnSegments(Vec3::Zero(), Vec3::Zero(), Vec3(0, -1, 0), Vec3(0, 1, 0), s, t, interior));
+}
+
+/// Two triangles (a, b, c) and (b, a, d) of a grid cell's size, 0.1 m: the hinge ab on the x axis, c at
+/// (0.1, -0.1), d folded about ab from (0, 0.1) to `degrees` (180: onto abc, its edge b d crossing a c at
+/// their midpoints). No particle is near a triangle it is not local to, so no particle-triangle contact can
+/// act: only the hinge's opposite edges can keep it from folding through itself.
+struct FoldedHinge {
+  explicit FoldedHinge(float degrees) {
+    MeshDesc d;
+    d.positions = {Vec3(0, 0, 0), Vec3(0.1f, 0, 0), Vec3(0.1f, -0.1f, 0), Vec3(0, 0.1f, 0)};
+    d.triangles = {0, 1, 2, 1, 0, 3};
+    d.totalMass = 0.01f;
+    FabricResult r = Fabric::fromMesh(d);
+    EXPECT_TRUE(r) << r.status.message();
+    fabric = r.fabric;
+    state.positions = fabric->restPositions();
+    state.positions.row(3) = wing(degrees).transpose();
+    state.velocities = Points::Zero(4, 3);
+    state.inverseMasses = Eigen::VectorXf::Ones(4);
+  }
+  static Vec3 wing(float degrees) {
+    const float r = degrees * kPi / 180.0f;
+    return Vec3(0.0f, 0.1f * std::cos(r), 0.1f * std::sin(r));
+  }
+  /// The signed distance of edge b d from edge a c along their common normal (0 where their closest points
+  /// are not inside both).
+  float separation() const {
+    const Points& x = state.positions;
+    const Vec3 a = test::row(x, 0), b = test::row(x, 1), c = test::row(x, 2), dd = test::row(x, 3);
+    float s, t;
+    bool interior;
+    if (!detail::closestOnSegments(a, c, b, dd, s, t, interior) || !interior) return 0.0f;
+    const Vec3 n = (c - a).cross(dd - b).normalized();
+    return n.dot((a + s * (c - a)) - (b + t * (dd - b)));
+  }
+  /// One 1/60 s frame of 8 substeps driving d at a constant velocity from `from` to `to` degrees, the
+  /// self-contacts searched as Cape::step searches them and solved after every substep (or not at all).
+  void drive(float from, float to, bool solve) {
+    constexpr float dt = 1.0f / 60.0f;
+    constexpr int substeps = 8;
+    const float h = dt / substeps;
+    state.velocities.row(3) = ((wing(to) - wing(from)) / dt).transpose();
+    CapeSettings settings = test::quietSettings();
+    settings.selfCollision = true;
+    const Eigen::VectorXf free = Eigen::VectorXf::Ones(4);
+    detail::SelfCollision self(*fabric);
+    const int every = self.schedule(state, free, settings, dt, substeps);
+    for (int k = 0; k < substeps; ++k) {
+      if (every > 0 && k % every == 0)
+        self.searchFor(state, free, settings, h * static_cast<float>(std::min(every, substeps - k)));
+      state.positions += h * state.velocities;
+      if (solve) self.solve(state.positions, state.inverseMasses.data(), self.thickness(settings));
+      edgeContacts = std::max(edgeContacts, self.edgeContacts().size());
+      pointContacts = std::max(pointContacts, self.contacts().size());
+    }
+    thickness = self.thickness(settings);
+  }
+  FabricPtr fabric;
+  CapeState state;
+  std::size_t edgeContacts = 0, pointContacts = 0;
+  float thickness = 0.0f;
+};
+
+// Two grid cells that share a side, folded flat over it and on, cross their diagonals in an X with every
+// vertex 0.6 spacings or more from the other triangle (the sprint-turn's remaining self-intersections, in
+// docs/SOLVER.md): the hinge's opposite edges are an edge-edge contact that keeps them on their sides.
+TEST(SelfCollision, AHingeFoldedOnDoesNotCrossItsOppositeEdges) {
+  FoldedHinge held(165.0f);
+  const float before = held.separation();
+  ASSERT_GT(before, 0.0f);
+  held.drive(165.0f, 200.0f, true);
+  EXPECT_EQ(held.pointContacts, 0u);
+  EXPECT_GT(held.edgeContacts, 0u);
+  const float after = held.separation();
+  EXPECT_GT(after, 0.9f * detail::kEdgeThicknessFraction * held.thickness) << "before " << before;
+  for (Eigen::Index i = 0; i < 4; ++i) EXPECT_TRUE(held.state.positions.row(i).allFinite());
+
+  // The same fold without the solve crosses: the test can fail.
+  FoldedHinge free(165.0f);
+  free.drive(165.0f, 200.0f, false);
+  EXPECT_LT(free.separation(), 0.0f);
+}
+
+// An open hinge's opposite edges are out of reach: a flat grid has no edge-edge contacts, and neither has a
+// hinge folded by a right angle.
+TEST(SelfCollision, OpenHingesAreNoEdgeContacts) {
+  for (const float degrees : {0.0f, 45.0f, 90.0f}) {
+    FoldedHinge open(degrees);
+    open.drive(degrees, degrees + 5.0f, true);
+    EXPECT_EQ(open.edgeContacts, 0u) << degrees << " degrees";
+  }
+  // Every hinge of a grid has two pairs of opposite edges: 20 x 20 has 19 * 19 * 3 - 2 * 19 interior edges.
+  FabricPtr grid = test::makeGrid(20, 20);
+  detail::SelfCollision self(*grid);
+  CapeState state;
+  state.positions = grid->restPositions();
+  state.velocities = Points::Zero(state.positions.rows(), 3);
+  CapeSettings settings;
+  settings.selfCollision = true;
+  const Eigen::VectorXf free = Eigen::VectorXf::Ones(state.positions.rows());
+  EXPECT_EQ(self.schedule(state, free, settings, 1.0f / 60.0f, 4), 0);
+  EXPECT_EQ(self.edgePairs().size(), 2u * (19u * 19u * 3u - 2u * 19u));
+  EXPECT_TRUE(self.edgeContacts().empty());
+}
+
 TEST(SelfCollision, NeighboursAreNeverContactsOnAFlatCape) {
   CapeSettings s;
   s.selfCollision = true;

@@ -26,8 +26,8 @@ constexpr StoredRun kStored[] = {
     {"--cape canonical --scene sprint-turn --self-collision", "219d452d1fb3c51d"},
     {"--cape canonical --simple-body --scene walk", "7e841931b51c1c66"},
     {"--cape canonical --simple-body --scene sprint-turn --self-collision", "dfcf10d4c7748c1b"},
-    {"--scene walk", "c4808c6d5dfaaad7"},
-    {"--scene sprint-turn", "05dd32c520eb0386"},
+    {"--scene walk", "d5fcace97338e4b1"},
+    {"--scene sprint-turn", "7b8adee9364732d9"},
 };
 #else
 constexpr StoredRun kStored[] = {
@@ -35,8 +35,8 @@ constexpr StoredRun kStored[] = {
     {"--cape canonical --scene sprint-turn --self-collision", "d80ddd74e7b20a8c"},
     {"--cape canonical --simple-body --scene walk", "5107e3ce3bf11888"},
     {"--cape canonical --simple-body --scene sprint-turn --self-collision", "7f31809400315d25"},
-    {"--scene walk", "cb35777365341713"},
-    {"--scene sprint-turn", "3415373131e18145"},
+    {"--scene walk", "7433ec2911ed9717"},
+    {"--scene sprint-turn", "ea06fbd5f25e90f3"},
 };
 #endif
 

@@ -183,6 +183,32 @@ bool besideAndApart(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, 
   return dk * dk + normal * normal * edge2 >= reach2 * den * edge2;
 }
 
+bool closestOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, float& s, float& t,
+                       bool& interior) {
+  // Minimise |r + s d1 - t d2|^2 (r = p0 - q0) over the square: the unconstrained minimum's s, clamped, then
+  // the best t for it, clamped, and if that clamp bit, the best s for that end of q.
+  const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const float a = d1.dot(d1), e = d2.dot(d2), b = d1.dot(d2), c = d1.dot(r), f = d2.dot(r);
+  interior = false;
+  if (!(a > 1e-20f && e > 1e-20f)) return false;
+  const float den = a * e - b * b;  // |d1 x d2|^2
+  // Parallel within about 0.06 degrees: any s will do (the closest points are not unique).
+  const bool parallel = !(den > 1e-6f * a * e);
+  const float free = parallel ? 0.0f : (b * f - c * e) / den;
+  s = std::clamp(free, 0.0f, 1.0f);
+  t = (b * s + f) / e;
+  if (t < 0.0f) {
+    t = 0.0f;
+    s = std::clamp(-c / a, 0.0f, 1.0f);
+  } else if (t > 1.0f) {
+    t = 1.0f;
+    s = std::clamp((b - c) / a, 0.0f, 1.0f);
+  } else {
+    interior = !parallel && free > 0.0f && free < 1.0f && t > 0.0f && t < 1.0f;
+  }
+  return true;
+}
+
 SelfCollision::SelfCollision(const Fabric& fabric) : fabric_(fabric) {
   const std::size_t n = fabric.particleCount(), triangles = fabric.triangleCount();
   // A hash of at least twice as many buckets as particles (a power of two).
@@ -369,6 +395,7 @@ CAPE_ALWAYS_INLINE inline void SelfCollision::consider(std::uint32_t q, const Ve
 
 void SelfCollision::find(const Points& x, const Points& v, float thickness) {
   contacts_.clear();
+  edgeContacts_.clear();
   // A cape that is no longer finite has blown up (the metrics report it); there is nothing to keep apart.
   if (!x.allFinite() || !v.allFinite()) return;
   // A pair can close in by at most their relative motion; the solver's own corrections (springs, collisions)
@@ -419,6 +446,154 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
       grownBox(t, tlo, thi);
       if (boxesOverlap(qlo, qhi, tlo.data(), thi.data())) consider(q, p, t, false);
     }
+  }
+  findEdges(x);
+}
+
+void SelfCollision::buildEdgePairs() {
+  // Every edge of two triangles (a, b, c) and (b, a, d) is a hinge, and its quad a-c-b-d has two pairs of
+  // opposite edges, (a c, b d) and (b c, a d). Visited from both triangles: kept from the one whose own
+  // corner is the lower index.
+  edgePairsBuilt_ = true;
+  const std::vector<std::uint32_t>& tri = fabric_.triangles();
+  const std::vector<TriangleLocalSet>& local = fabric_.triangleLocal();
+  for (std::size_t t = 0; t < fabric_.triangleCount(); ++t)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = tri[3 * t + k], b = tri[3 * t + (k + 1) % 3], c = tri[3 * t + (k + 2) % 3];
+      const std::uint32_t d = local[t].v[3 + k];
+      if (d == ~0u || !(c < d) || d == a || d == b) continue;
+      edgePairs_.push_back({a, c, b, d});
+      edgePairs_.push_back({b, c, a, d});
+    }
+  edgeAxis_.assign(3 * edgePairs_.size(), 0.0f);  // none yet: every pair's first search is exact
+}
+
+void SelfCollision::findEdges(const Points& x) {
+  // The particle-triangle contacts leave out a triangle's own hinge: a particle is local to the triangles
+  // across its triangle's edges (isLocal), and a hinge folded flat has no vertex near the other triangle's
+  // face. Folded further, its triangles cross edge through edge: the hinge quad's opposite edges make an X
+  // (two grid cells folded over their shared side cross their diagonals; a cell folded over its diagonal,
+  // its opposite sides), each vertex still 0.6 spacings or more from the other triangle. Such a pair is
+  // kept apart by an edge-edge contact, found as the particle-triangle ones are: within the thickness plus
+  // the slack plus their relative predicted motion.
+  if (!edgePairsBuilt_) buildEdgePairs();
+  const float edgeThickness = kEdgeThicknessFraction * thickness_;
+  const float* norm = stepMotionNorm_.data();
+  const float *px = x.col(0).data(), *py = x.col(1).data(), *pz = x.col(2).data();
+  // A hinge's two pairs (buildEdgePairs: consecutive) have the same four particles, read once for both.
+  for (std::size_t i = 0; i + 1 < edgePairs_.size(); i += 2) {
+    const EdgePair& h = edgePairs_[i];  // a = p0, c = p1, b = q0, d = q1
+    const Vec3 a(px[h.p0], py[h.p0], pz[h.p0]), c(px[h.p1], py[h.p1], pz[h.p1]),
+        b(px[h.q0], py[h.q0], pz[h.q0]), d(px[h.q1], py[h.q1], pz[h.q1]);
+    const float reachA = norm[h.p0], reachC = norm[h.p1], reachB = norm[h.q0], reachD = norm[h.q1];
+    // Most hinges are open: their opposite edges a spacing or so apart, out of reach of any motion the
+    // search allows. The gap between the edges' projections onto any unit axis is at most their distance:
+    // onto the direction that separated them at their last exact test, a hinge that has not turned much
+    // since is passed over without its closest points (most hinges at every search), first with each end's
+    // whole motion, then with its motion along the axis.
+    const float* axisAC = &edgeAxis_[3 * i];
+    const float* axisBC = &edgeAxis_[3 * i + 3];
+    const Vec3 uAC(axisAC[0], axisAC[1], axisAC[2]), uBC(axisBC[0], axisBC[1], axisBC[2]);
+    const float nearAC = edgeThickness + slack_ + std::max(reachA, reachC) + std::max(reachB, reachD);
+    const float nearBC = edgeThickness + slack_ + std::max(reachB, reachC) + std::max(reachA, reachD);
+    const bool openAC = std::min(uAC.dot(a), uAC.dot(c)) - std::max(uAC.dot(b), uAC.dot(d)) > nearAC;
+    const bool openBC = std::min(uBC.dot(b), uBC.dot(c)) - std::max(uBC.dot(a), uBC.dot(d)) > nearBC;
+    if (openAC && openBC) continue;
+    if (!openAC) considerEdgePair(i, x);
+    if (!openBC) considerEdgePair(i + 1, x);
+  }
+}
+
+void SelfCollision::considerEdgePair(std::size_t i, const Points& x) {
+  const EdgePair& e = edgePairs_[i];
+  const float edgeThickness = kEdgeThicknessFraction * thickness_;
+  const float* norm = stepMotionNorm_.data();
+  const float *mx = stepMotion_.col(0).data(), *my = stepMotion_.col(1).data(),
+              *mz = stepMotion_.col(2).data();
+  const Vec3 p0 = at(x, e.p0), p1 = at(x, e.p1), q0 = at(x, e.q0), q1 = at(x, e.q1);
+  float* axis = &edgeAxis_[3 * i];
+  {
+    const Vec3 u(axis[0], axis[1], axis[2]);
+    const auto along = [&u, mx, my, mz](std::uint32_t k) {
+      return u.x() * mx[k] + u.y() * my[k] + u.z() * mz[k];
+    };
+    const float lowest = std::min(u.dot(p0), u.dot(p1)) + std::min({0.0f, along(e.p0), along(e.p1)});
+    const float highest = std::max(u.dot(q0), u.dot(q1)) + std::max({0.0f, along(e.q0), along(e.q1)});
+    if (lowest - highest > edgeThickness + slack_) return;
+  }
+  float s, t;
+  bool interior;
+  if (!closestOnSegments(p0, p1, q0, q1, s, t, interior)) return;
+  const Vec3 gap = (p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0));
+  const float gap2 = gap.squaredNorm();
+  if (gap2 > 0.0f && std::isfinite(gap2)) {
+    const Vec3 unit = gap / std::sqrt(gap2);  // from q's edge to p's: p's projection is the higher
+    axis[0] = unit.x();
+    axis[1] = unit.y();
+    axis[2] = unit.z();
+  }
+  const float loose =
+      edgeThickness + slack_ + std::max(norm[e.p0], norm[e.p1]) + std::max(norm[e.q0], norm[e.q1]);
+  if (gap2 > loose * loose) return;
+  // The relative motion of any two points of the edges is a weighted mean of their ends' relative motions.
+  const Vec3 m0 = stepMotion_.row(e.p0).transpose(), m1 = stepMotion_.row(e.p1).transpose();
+  const Vec3 n0 = stepMotion_.row(e.q0).transpose(), n1 = stepMotion_.row(e.q1).transpose();
+  const float closing = std::sqrt(std::max(
+      {(m0 - n0).squaredNorm(), (m0 - n1).squaredNorm(), (m1 - n0).squaredNorm(), (m1 - n1).squaredNorm()}));
+  const float within = edgeThickness + slack_ + closing;
+  if (gap2 > within * within) return;
+  float side = 0.0f;
+  if (interior) {
+    const float g = (p1 - p0).cross(q1 - q0).dot(gap);
+    side = g > 0.0f ? 1.0f : (g < 0.0f ? -1.0f : 0.0f);
+  }
+  edgeContacts_.push_back({static_cast<std::uint32_t>(i), side});
+}
+
+void SelfCollision::solveEdges(Points& x, const float* w, float thickness, float maxCrossing) {
+  const float edgeThickness = kEdgeThicknessFraction * thickness;
+  for (EdgeContact& k : edgeContacts_) {
+    const EdgePair& e = edgePairs_[k.pair];
+    const Vec3 p0 = at(x, e.p0), p1 = at(x, e.p1), q0 = at(x, e.q0), q1 = at(x, e.q1);
+    // Apart along the search's separating direction by the thickness: apart, and on the side they were on.
+    const Vec3 axis(edgeAxis_[3 * k.pair], edgeAxis_[3 * k.pair + 1], edgeAxis_[3 * k.pair + 2]);
+    if (std::min(axis.dot(p0), axis.dot(p1)) - std::max(axis.dot(q0), axis.dot(q1)) >= edgeThickness)
+      continue;
+    float s, t;
+    bool interior;
+    if (!closestOnSegments(p0, p1, q0, q1, s, t, interior)) continue;
+    const Vec3 gap = (p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0));
+    Vec3 normal;
+    float distance;
+    if (interior) {
+      // The closest points inside both edges: keep p's edge on the side of q's it started on (or first came
+      // to lie across from), along the edges' common normal.
+      Vec3 n = (p1 - p0).cross(q1 - q0);
+      const float len = n.norm();
+      if (!(len > 0.0f)) continue;
+      n /= len;
+      if (k.side == 0.0f) k.side = n.dot(gap) >= 0.0f ? 1.0f : -1.0f;
+      normal = k.side * n;
+      distance = normal.dot(gap);             // negative: they have crossed, and are brought back
+      if (distance < -maxCrossing) continue;  // not a crossing within this step (as for a particle)
+    } else {
+      // At an end of either edge: a plain distance, no side to keep.
+      distance = gap.norm();
+      if (!(distance > 1e-9f)) continue;
+      normal = gap / distance;
+    }
+    if (!(distance < edgeThickness)) continue;
+    // PBD edge-edge constraint C = n . (p(s) - q(t)) - thickness >= 0: gradients (1 - s) n, s n for p's ends,
+    // -(1 - t) n, -t n for q's. The denominator is bounded below as the particle-triangle one is.
+    const float wp0 = w[e.p0] * (1.0f - s), wp1 = w[e.p1] * s, wq0 = w[e.q0] * (1.0f - t), wq1 = w[e.q1] * t;
+    const float denominator = std::max(wp0 * (1.0f - s) + wp1 * s + wq0 * (1.0f - t) + wq1 * t,
+                                       std::max({wp0, wp1, wq0, wq1}) / kMaxCornerAmplification);
+    if (!(denominator > 0.0f)) continue;
+    const Vec3 step = ((edgeThickness - distance) / denominator) * normal;
+    x.row(e.p0) += wp0 * step.transpose();
+    x.row(e.p1) += wp1 * step.transpose();
+    x.row(e.q0) -= wq0 * step.transpose();
+    x.row(e.q1) -= wq1 * step.transpose();
   }
 }
 
@@ -583,6 +758,7 @@ void SelfCollision::solve(Points& x, const float* w, float thickness) {
     x.row(ib) -= (invB * bary.wb) * step.transpose();
     x.row(ic) -= (invC * bary.wc) * step.transpose();
   }
+  if (!edgeContacts_.empty()) solveEdges(x, w, thickness, maxCrossing);
 }
 
 }  // namespace cape::detail

@@ -24,6 +24,16 @@ inline constexpr float kFaceMargin = 0.25f;
 /// decides.
 bool besideAndApart(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float thickness);
 
+/// The closest points of segments p0-p1 and q0-q1: p0 + s (p1 - p0) and q0 + t (q1 - q0), s and t in [0, 1].
+/// `interior` when both lie strictly inside their segments and the segments are not parallel: the points are
+/// then unique and their difference is along (p1 - p0) x (q1 - q0). false if either segment is degenerate.
+bool closestOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, float& s, float& t,
+                       bool& interior);
+
+/// The edge-edge self-contacts' thickness, as a fraction of the particle-triangle one (SelfCollision.cpp
+/// explains the choice).
+inline constexpr float kEdgeThicknessFraction = 0.4f;
+
 class SelfCollision {
  public:
   explicit SelfCollision(const Fabric& fabric);
@@ -44,13 +54,28 @@ class SelfCollision {
   /// with inverse masses `w`).
   void solve(Points& positions, const float* w, float thickness);
 
+  /// A pair of opposite edges of a hinge (two triangles sharing an edge, seen as a quad): p0-p1 and q0-q1.
+  struct EdgePair {
+    std::uint32_t p0, p1, q0, q1;
+  };
+  /// An edge-edge contact: a pair within reach at the search, and the side of q's edge p's was on (+1, -1,
+  /// or 0 while their closest points are not both inside the edges).
+  struct EdgeContact {
+    std::uint32_t pair;  ///< Index into edgePairs().
+    float side;
+  };
+
   /// Drops the contacts: the next step searches afresh (the cape was put somewhere else).
   void forget() {
     contacts_.clear();
+    edgeContacts_.clear();
     validUntil_ = -std::numeric_limits<double>::infinity();
   }
 
   const std::vector<Cape::SelfContact>& contacts() const { return contacts_; }
+  /// Every hinge's two pairs of opposite edges (built at the first search; empty before).
+  const std::vector<EdgePair>& edgePairs() const { return edgePairs_; }
+  const std::vector<EdgeContact>& edgeContacts() const { return edgeContacts_; }
   std::uint64_t searches() const { return searches_; }
 
  private:
@@ -66,9 +91,19 @@ class SelfCollision {
   void grownBox(std::uint32_t t, Vec3& lo, Vec3& hi) const;
   /// Whether the particle being scanned has as many contacts as a search keeps for one.
   bool particleFull() const;
+  /// The hinges' opposite edges within reach (find's last part).
+  void findEdges(const Points& x);
+  void buildEdgePairs();
+  /// Edge pair i that the cheap test could not pass over: the exact test, and the contact if within reach.
+  void considerEdgePair(std::size_t i, const Points& x);
+  void solveEdges(Points& x, const float* w, float thickness, float maxCrossing);
 
   const Fabric& fabric_;
   std::vector<Cape::SelfContact> contacts_;
+  std::vector<EdgePair> edgePairs_;
+  bool edgePairsBuilt_ = false;
+  std::vector<float> edgeAxis_;  ///< Per edge pair: the unit direction that last separated its edges.
+  std::vector<EdgeContact> edgeContacts_;
   double validUntil_ = -1.0;    ///< s: the contacts cover the motion until this time.
   std::uint64_t searches_ = 0;  ///< Searches so far (diagnostics).
 
