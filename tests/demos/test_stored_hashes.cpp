@@ -26,8 +26,8 @@ constexpr StoredRun kStored[] = {
     {"--cape canonical --scene sprint-turn --self-collision", "219d452d1fb3c51d"},
     {"--cape canonical --simple-body --scene walk", "7e841931b51c1c66"},
     {"--cape canonical --simple-body --scene sprint-turn --self-collision", "dfcf10d4c7748c1b"},
-    {"--scene walk", "d5fcace97338e4b1"},
-    {"--scene sprint-turn", "7b8adee9364732d9"},
+    {"--scene walk", "5ed6f176cefa5f64"},
+    {"--scene sprint-turn", "d37721ee5891ea0c"},
 };
 #else
 constexpr StoredRun kStored[] = {
@@ -35,8 +35,8 @@ constexpr StoredRun kStored[] = {
     {"--cape canonical --scene sprint-turn --self-collision", "d80ddd74e7b20a8c"},
     {"--cape canonical --simple-body --scene walk", "5107e3ce3bf11888"},
     {"--cape canonical --simple-body --scene sprint-turn --self-collision", "7f31809400315d25"},
-    {"--scene walk", "7433ec2911ed9717"},
-    {"--scene sprint-turn", "ea06fbd5f25e90f3"},
+    {"--scene walk", "9665de51720970b2"},
+    {"--scene sprint-turn", "2bc0182d43c1cd4c"},
 };
 #endif
 

@@ -475,7 +475,9 @@ void SelfCollision::findEdges(const Points& x) {
   // (two grid cells folded over their shared side cross their diagonals; a cell folded over its diagonal,
   // its opposite sides), each vertex still 0.6 spacings or more from the other triangle. Such a pair is
   // kept apart by an edge-edge contact, found as the particle-triangle ones are: within the thickness plus
-  // the slack plus their relative predicted motion.
+  // the slack plus their relative predicted motion. The edge thickness is a fifth of the particle one
+  // (kEdgeThicknessFraction): a clean fold's opposite edges lie about half as far apart as its layers, and
+  // a gathered collar's pleats closer still, which twice that held open (docs/SOLVER.md).
   if (!edgePairsBuilt_) buildEdgePairs();
   const float edgeThickness = kEdgeThicknessFraction * thickness_;
   const float* norm = stepMotionNorm_.data();

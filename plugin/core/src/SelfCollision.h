@@ -32,7 +32,7 @@ bool closestOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec
 
 /// The edge-edge self-contacts' thickness, as a fraction of the particle-triangle one (SelfCollision.cpp
 /// explains the choice).
-inline constexpr float kEdgeThicknessFraction = 0.4f;
+inline constexpr float kEdgeThicknessFraction = 0.2f;
 
 class SelfCollision {
  public:
