@@ -467,8 +467,11 @@ void BulletScene::startCape(int character, bullet::CapeAction& action) const {
   Cape& cape = action.cape();
   const Points& rest = cape.fabric().restPositions();
   Points& x = cape.mutableState().positions;
+  const bool level = options_.scene == SceneKind::Hang;  // starts sticking out behind: capeStartPlacement
   for (Eigen::Index i = 0; i < rest.rows(); ++i) {
-    const Vec3 at = placement.apply(gatheredPoint(rest.row(i).transpose(), capeSize_, collar_));
+    const Vec3 local = rest.row(i).transpose();
+    const Vec3 at = placement.apply(level ? gatheredLevelPoint(local, capeSize_, collar_)
+                                          : gatheredPoint(local, capeSize_, collar_));
     x.row(i) = (at.cast<double>() + shift).cast<float>().transpose();
   }
 }

@@ -210,6 +210,16 @@ Vec3 gatheredPoint(const Vec3& local, const CapeSize& size, const CollarShape& c
               local.z() - along * collar.wrap * s * s);
 }
 
+Vec3 gatheredLevelPoint(const Vec3& local, const CapeSize& size, const CollarShape& collar) {
+  const float half = 0.5f * size.width;
+  const float s = (local.x() - half) / half;  // -1 at the left edge, +1 at the right
+  // Each column moved up the cape (towards its top) by the collar's wrap at its place: under the hang's
+  // turn (capeStartPlacement) that is forward, as the collar's ends go, so every column's top is on the
+  // collar and the column follows it straight, at its rest length.
+  return Vec3(half + (local.x() - half) * (collar.span / size.width), local.y() + collar.wrap * s * s,
+              local.z());
+}
+
 CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings, const CapeSize& size, int rows,
                     float totalMass, const CollarShape& collar) {
   CapeRig rig;

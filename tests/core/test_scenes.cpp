@@ -126,6 +126,41 @@ TEST(Scenes, AGatheredCapeHangsFromAnArcAcrossTheShoulders) {
   EXPECT_NEAR(third.z(), 0.15f, 1e-6f);
 }
 
+// The hang starts the cape level, sticking out behind (capeStartPlacement turns the grid's -Y onto +Z), from
+// the same collar pins as the walk. gatheredPoint bends the top rows forward in the grid's z, which the turn
+// makes downward: its top row missed the pins by up to wrap * sqrt(2), 7 cm here (4.5 spacings of a 64 x 64
+// cape), and the first step snapped it there. gatheredLevelPoint's top row is on the pins, and every column
+// straight at its rest spacing.
+TEST(Scenes, AGatheredCapeStartingLevelHasItsTopRowOnTheCollarPins) {
+  CollarShape collar;
+  collar.span = 0.35f;
+  collar.wrap = 0.05f;
+  const CapeRig rig = makeCapeRig(20, PinLayout::Gathered, true, CapeSize(), 0, 0.0f, collar);
+  ASSERT_TRUE(rig.fabric);
+  const Pose hang = capeStartPlacement(SceneKind::Hang);
+  const Points& rest = rig.fabric->restPositions();
+  float oldMiss = 0.0f;
+  for (std::size_t k = 0; k < 20; ++k) {
+    const Vec3 local = rest.row(static_cast<Eigen::Index>(k)).transpose();
+    EXPECT_LT((hang.apply(gatheredLevelPoint(local, CapeSize(), collar)) - rig.pinLocalPoints[k]).norm(),
+              1e-6f)
+        << "column " << k;
+    oldMiss = std::max(oldMiss,
+                       (hang.apply(gatheredPoint(local, CapeSize(), collar)) - rig.pinLocalPoints[k]).norm());
+  }
+  EXPECT_GT(oldMiss, 0.07f);
+  // Each column straight, level (the pin line's height) and at the rest spacing of 1/19 m.
+  for (int col = 0; col < 20; ++col)
+    for (int row = 0; row + 1 < 20; ++row) {
+      const Vec3 a = hang.apply(gatheredLevelPoint(rest.row(row * 20 + col).transpose(), CapeSize(), collar));
+      const Vec3 b =
+          hang.apply(gatheredLevelPoint(rest.row((row + 1) * 20 + col).transpose(), CapeSize(), collar));
+      EXPECT_NEAR((b - a).norm(), 1.0f / 19.0f, 1e-5f);
+      EXPECT_NEAR(b.y(), 1.56f, 1e-6f);
+      EXPECT_GT(b.z(), a.z());  // out behind
+    }
+}
+
 TEST(Metrics, FoldMeterMeasuresDihedralAnglesAndTheirChange) {
   const CapeRig rig = makeCapeRig(5, PinLayout::Corners);  // 5 x 5: 16 cells, 32 triangles
   const Fabric& f = *rig.fabric;

@@ -118,6 +118,12 @@ struct CollarShape {
 /// top, fading out over 6 cm down the cape). capeStartPlacement maps it into the character frame; the top
 /// row's images are the pins of makeCapeRig's Gathered layout.
 CAPE_SCENES_API Vec3 gatheredPoint(const Vec3& local, const CapeSize& size, const CollarShape& collar);
+/// Where a point of the grid starts when the cape is gathered onto `collar` and starts level, sticking out
+/// behind it (SceneKind::Hang): x pulled in as gatheredPoint does, and each column moved along the cape by
+/// the collar's wrap at its place, so that under the hang's turn the top row lies on the collar exactly as
+/// gatheredPoint's does under the walk's (the pins of makeCapeRig's Gathered layout), and every column
+/// starts straight and at its rest length.
+CAPE_SCENES_API Vec3 gatheredLevelPoint(const Vec3& local, const CapeSize& size, const CollarShape& collar);
 
 /// Character-frame attachment points: "corners" pins the top corners at (+-0.30, 1.56, 0.15); "collar" pins
 /// the whole top row along the same line; "gathered" pins the whole top row on `collar` (gatheredPoint).
