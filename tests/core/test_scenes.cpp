@@ -94,12 +94,18 @@ TEST(Scenes, CapeRigs) {
   EXPECT_EQ(collar.pinnedParticles.size(), 20u);
 }
 
-TEST(Scenes, AGatheredCapeHangsFromAnArcAcrossTheShoulders) {
-  // A 0.6 m cape on a 0.35 m collar whose ends come 5 cm forward: the whole top row pinned, evenly along X
-  // from -0.175 to +0.175, on the parabola z = 0.15 - 0.05 (2x / 0.35)^2 at the pin line's height.
+/// A collar 0.35 m across whose ends come 5 cm forward (narrower and deeper than the default).
+CollarShape narrowCollar() {
   CollarShape collar;
   collar.span = 0.35f;
   collar.wrap = 0.05f;
+  return collar;
+}
+
+TEST(Scenes, AGatheredCapeHangsFromAnArcAcrossTheShoulders) {
+  // A 0.6 m cape on narrowCollar(): the whole top row pinned, evenly along X from -0.175 to +0.175, on the
+  // parabola z = 0.15 - 0.05 (2x / 0.35)^2 at the pin line's height.
+  const CollarShape collar = narrowCollar();
   const CapeRig rig = makeCapeRig(20, PinLayout::Gathered, true, CapeSize(), 0, 0.0f, collar);
   ASSERT_TRUE(rig.fabric);
   ASSERT_EQ(rig.pinnedParticles.size(), 20u);
@@ -128,13 +134,11 @@ TEST(Scenes, AGatheredCapeHangsFromAnArcAcrossTheShoulders) {
 
 // The hang starts the cape level, sticking out behind (capeStartPlacement turns the grid's -Y onto +Z), from
 // the same collar pins as the walk. gatheredPoint bends the top rows forward in the grid's z, which the turn
-// makes downward: its top row missed the pins by up to wrap * sqrt(2), 7 cm here (4.5 spacings of a 64 x 64
-// cape), and the first step snapped it there. gatheredLevelPoint's top row is on the pins, and every column
-// straight at its rest spacing.
+// makes downward: its top row missed the pins by up to wrap * sqrt(2), 7 cm here (4.2 cm with the default
+// collar: 4.5 spacings of a 64 x 64 cape), and the first step snapped it there. gatheredLevelPoint's top row
+// is on the pins, and every column straight at its rest spacing.
 TEST(Scenes, AGatheredCapeStartingLevelHasItsTopRowOnTheCollarPins) {
-  CollarShape collar;
-  collar.span = 0.35f;
-  collar.wrap = 0.05f;
+  const CollarShape collar = narrowCollar();
   const CapeRig rig = makeCapeRig(20, PinLayout::Gathered, true, CapeSize(), 0, 0.0f, collar);
   ASSERT_TRUE(rig.fabric);
   const Pose hang = capeStartPlacement(SceneKind::Hang);

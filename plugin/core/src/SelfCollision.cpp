@@ -137,6 +137,12 @@ inline bool boxesOverlap(const float* qlo, const float* qhi, const float* lo, co
          (qlo[2] <= hi[2]);
 }
 
+/// How far segment p0-p1's projection onto unit axis u lies above q0-q1's (negative where they overlap): at
+/// most the segments' distance, for any unit u.
+inline float separationAlong(const Vec3& u, const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
+  return std::min(u.dot(p0), u.dot(p1)) - std::max(u.dot(q0), u.dot(q1));
+}
+
 }  // namespace
 
 bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float& wa, float& wb,
@@ -498,8 +504,8 @@ void SelfCollision::findEdges(const Points& x) {
     const Vec3 uAC(axisAC[0], axisAC[1], axisAC[2]), uBC(axisBC[0], axisBC[1], axisBC[2]);
     const float nearAC = edgeThickness + slack_ + std::max(reachA, reachC) + std::max(reachB, reachD);
     const float nearBC = edgeThickness + slack_ + std::max(reachB, reachC) + std::max(reachA, reachD);
-    const bool openAC = std::min(uAC.dot(a), uAC.dot(c)) - std::max(uAC.dot(b), uAC.dot(d)) > nearAC;
-    const bool openBC = std::min(uBC.dot(b), uBC.dot(c)) - std::max(uBC.dot(a), uBC.dot(d)) > nearBC;
+    const bool openAC = separationAlong(uAC, a, c, b, d) > nearAC;
+    const bool openBC = separationAlong(uBC, b, c, a, d) > nearBC;
     if (openAC && openBC) continue;
     if (!openAC) considerEdgePair(i, x);
     if (!openBC) considerEdgePair(i + 1, x);
@@ -559,8 +565,7 @@ void SelfCollision::solveEdges(Points& x, const float* w, float thickness, float
     const Vec3 p0 = at(x, e.p0), p1 = at(x, e.p1), q0 = at(x, e.q0), q1 = at(x, e.q1);
     // Apart along the search's separating direction by the thickness: apart, and on the side they were on.
     const Vec3 axis(edgeAxis_[3 * k.pair], edgeAxis_[3 * k.pair + 1], edgeAxis_[3 * k.pair + 2]);
-    if (std::min(axis.dot(p0), axis.dot(p1)) - std::max(axis.dot(q0), axis.dot(q1)) >= edgeThickness)
-      continue;
+    if (separationAlong(axis, p0, p1, q0, q1) >= edgeThickness) continue;
     float s, t;
     bool interior;
     if (!closestOnSegments(p0, p1, q0, q1, s, t, interior)) continue;
