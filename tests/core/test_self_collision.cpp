@@ -369,6 +369,31 @@ TEST(SelfCollision, OpenHingesAreNoEdgeContacts) {
   EXPECT_TRUE(self.edgeContacts().empty());
 }
 
+// A cape keeps the search's scratch only once it searches: a crowd of capes without self-collision holds
+// none of it. Sized at the first search, and not grown by the next ones on the same cape.
+TEST(SelfCollision, TheSearchScratchIsAllocatedAtTheFirstSearch) {
+  FabricPtr grid = test::makeGrid(20, 20);
+  detail::SelfCollision self(*grid);
+  EXPECT_EQ(self.scratchBytes(), 0u);
+  CapeState state;
+  state.positions = grid->restPositions();
+  state.velocities = Points::Zero(state.positions.rows(), 3);
+  CapeSettings settings;
+  settings.selfCollision = true;
+  const Eigen::VectorXf free = Eigen::VectorXf::Ones(state.positions.rows());
+  EXPECT_EQ(self.schedule(state, free, settings, 1.0f / 60.0f, 4), 0);
+  const std::size_t first = self.scratchBytes();
+  // At least the contacts' reserve (32 per particle) and the hash (two buckets per particle).
+  EXPECT_GE(first, 400u * (32u * sizeof(Cape::SelfContact) + 2u * sizeof(std::uint32_t)));
+  for (int f = 1; f <= 10; ++f) {
+    state.time = f / 60.0;
+    state.positions.col(1).array() -= 0.001f * static_cast<float>(f);
+    EXPECT_EQ(self.schedule(state, free, settings, 1.0f / 60.0f, 4), 0);
+  }
+  EXPECT_EQ(self.searches(), 11u);
+  EXPECT_EQ(self.scratchBytes(), first);
+}
+
 TEST(SelfCollision, NeighboursAreNeverContactsOnAFlatCape) {
   CapeSettings s;
   s.selfCollision = true;

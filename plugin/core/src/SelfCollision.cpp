@@ -215,8 +215,14 @@ bool closestOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec
   return true;
 }
 
-SelfCollision::SelfCollision(const Fabric& fabric) : fabric_(fabric) {
-  const std::size_t n = fabric.particleCount(), triangles = fabric.triangleCount();
+SelfCollision::SelfCollision(const Fabric& fabric) : fabric_(fabric) {}
+
+void SelfCollision::allocate() {
+  // The search's scratch, sized once at the first search: a cape that never turns self-collision on keeps
+  // none of it (a 20 x 20 cape's is about 270 kB, most of it the contacts' reserve).
+  if (allocated_) return;
+  allocated_ = true;
+  const std::size_t n = fabric_.particleCount(), triangles = fabric_.triangleCount();
   // A hash of at least twice as many buckets as particles (a power of two).
   std::uint32_t buckets = 1;
   while (buckets < 2 * static_cast<std::uint32_t>(n)) buckets <<= 1;
@@ -228,13 +234,23 @@ SelfCollision::SelfCollision(const Fabric& fabric) : fabric_(fabric) {
   triangleStamp_.assign(triangles, 0u);
   largeTriangles_.reserve(triangles);
   clusterBuckets_.reserve(8 * triangles);
-  clusterBoxes_.assign(6 * fabric.clusterCount(), 0.0f);
-  clusterBucketStart_.assign(fabric.clusterCount() + 1, 0u);
+  clusterBoxes_.assign(6 * fabric_.clusterCount(), 0.0f);
+  clusterBucketStart_.assign(fabric_.clusterCount() + 1, 0u);
   stepMotion_ = Points::Zero(static_cast<Eigen::Index>(n), 3);
   sweptLo_ = Points::Zero(static_cast<Eigen::Index>(n), 3);
   sweptHi_ = Points::Zero(static_cast<Eigen::Index>(n), 3);
   stepMotionNorm_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(n));
   contacts_.reserve(32 * n);
+}
+
+std::size_t SelfCollision::scratchBytes() const {
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  const auto points = [](const auto& m) { return static_cast<std::size_t>(m.size()) * sizeof(float); };
+  return bytes(contacts_) + bytes(edgePairs_) + bytes(edgeAxis_) + bytes(edgeContacts_) + bytes(hashStart_) +
+         bytes(hashEntries_) + bytes(bucketHits_) + bytes(triangleMotion_) + bytes(triangleStamp_) +
+         bytes(largeTriangles_) + bytes(clusterBoxes_) + bytes(clusterBuckets_) + bytes(clusterBucketStart_) +
+         bytes(bucketCluster_) + points(stepMotion_) + points(stepMotionNorm_) + points(sweptLo_) +
+         points(sweptHi_);
 }
 
 float SelfCollision::thickness(const CapeSettings& settings) const {
@@ -255,6 +271,7 @@ int SelfCollision::schedule(const CapeState& state, const Eigen::VectorXf& freeM
   // every few substeps: a search over a whole fast frame would pair every particle with every triangle it
   // might sweep past, and the substeps would carry thousands of contacts.
   if (!(state.time + static_cast<double>(dt) > validUntil_ + 1e-9)) return 0;  // still covered
+  allocate();
   const float spacing = fabric_.meanSpacing();
   // The fastest particle relative to the cape's rigid motion (predictMotion), m/s.
   const float fastest = predictMotion(state, freeMask, settings.gravity, dt) / dt;
@@ -280,6 +297,7 @@ int SelfCollision::schedule(const CapeState& state, const Eigen::VectorXf& freeM
 
 void SelfCollision::searchFor(const CapeState& state, const Eigen::VectorXf& freeMask,
                               const CapeSettings& settings, float window) {
+  allocate();
   predictMotion(state, freeMask, settings.gravity, window);
   find(state.positions, state.velocities, thickness(settings));
   ++searches_;

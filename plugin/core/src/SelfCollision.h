@@ -77,8 +77,12 @@ class SelfCollision {
   const std::vector<EdgePair>& edgePairs() const { return edgePairs_; }
   const std::vector<EdgeContact>& edgeContacts() const { return edgeContacts_; }
   std::uint64_t searches() const { return searches_; }
+  /// Bytes held by the search's scratch: none until the first search.
+  std::size_t scratchBytes() const;
 
  private:
+  /// Sizes the search's scratch, at the first search.
+  void allocate();
   float predictMotion(const CapeState& state, const Eigen::VectorXf& freeMask, const Vec3& gravity, float dt);
   void find(const Points& x, const Points& v, float thickness);
   /// Bins every cluster's grown box into the hash (find's first half).
@@ -107,7 +111,8 @@ class SelfCollision {
   double validUntil_ = -1.0;    ///< s: the contacts cover the motion until this time.
   std::uint64_t searches_ = 0;  ///< Searches so far (diagnostics).
 
-  // The search's scratch, sized once.
+  // The search's scratch, sized once (allocate()).
+  bool allocated_ = false;
   std::vector<std::uint32_t> hashStart_;  ///< Spatial hash: bucket offsets (buckets + 1).
   /// A cluster of triangles in a bucket of the spatial hash, with its grown box inline: the search reads
   /// entries in order and rejects most by the box without touching the triangles.
