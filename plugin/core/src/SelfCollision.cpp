@@ -633,16 +633,30 @@ void SelfCollision::bin() {
   std::fill(hashStart_.begin(), hashStart_.end(), 0u);
   std::fill(bucketCluster_.begin(), bucketCluster_.end(), ~0u);
   const std::size_t clusters = fabric_.clusterCount();
+  // The union of a cluster's grown boxes is its corners' swept boxes' union, grown once (a rounded
+  // subtraction of the same amount keeps the order: the same bits as growing each triangle's box).
+  const float grow = thickness_ + slack_;
+  const float* norm = stepMotionNorm_.data();
+  const float *lx = sweptLo_.col(0).data(), *ly = sweptLo_.col(1).data(), *lz = sweptLo_.col(2).data();
+  const float *hx = sweptHi_.col(0).data(), *hy = sweptHi_.col(1).data(), *hz = sweptHi_.col(2).data();
   for (std::size_t g = 0; g < clusters; ++g) {
     clusterBucketStart_[g] = static_cast<std::uint32_t>(clusterBuckets_.size());
-    Vec3 lo = Vec3::Constant(std::numeric_limits<float>::max()), hi = -lo;
+    float lo[3], hi[3];
+    lo[0] = lo[1] = lo[2] = std::numeric_limits<float>::max();
+    hi[0] = hi[1] = hi[2] = -std::numeric_limits<float>::max();
     for (std::uint32_t t = clusterStart[g]; t < clusterStart[g + 1]; ++t) {
-      triangleMotion_[t] = std::max(
-          {stepMotionNorm_[tri[3 * t]], stepMotionNorm_[tri[3 * t + 1]], stepMotionNorm_[tri[3 * t + 2]]});
-      Vec3 tlo, thi;
-      grownBox(t, tlo, thi);
-      lo = lo.cwiseMin(tlo);
-      hi = hi.cwiseMax(thi);
+      const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
+      triangleMotion_[t] = std::max(std::max(norm[ia], norm[ib]), norm[ic]);
+      lo[0] = std::min(lo[0], std::min(std::min(lx[ia], lx[ib]), lx[ic]));
+      lo[1] = std::min(lo[1], std::min(std::min(ly[ia], ly[ib]), ly[ic]));
+      lo[2] = std::min(lo[2], std::min(std::min(lz[ia], lz[ib]), lz[ic]));
+      hi[0] = std::max(hi[0], std::max(std::max(hx[ia], hx[ib]), hx[ic]));
+      hi[1] = std::max(hi[1], std::max(std::max(hy[ia], hy[ib]), hy[ic]));
+      hi[2] = std::max(hi[2], std::max(std::max(hz[ia], hz[ib]), hz[ic]));
+    }
+    for (int k = 0; k < 3; ++k) {
+      lo[k] -= grow;
+      hi[k] += grow;
     }
     float* clusterBox = &clusterBoxes_[6 * g];
     for (int k = 0; k < 3; ++k) {
@@ -650,7 +664,7 @@ void SelfCollision::bin() {
       clusterBox[3 + k] = hi[k];
     }
     int range[8];
-    if (!cellsOf(invCell_, lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z(), range)) {
+    if (!cellsOf(invCell_, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], range)) {
       for (std::uint32_t t = clusterStart[g]; t < clusterStart[g + 1]; ++t) largeTriangles_.push_back(t);
       continue;
     }
