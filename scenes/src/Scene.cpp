@@ -273,6 +273,21 @@ SimpleScene::SimpleScene(SceneKind kind, int n, PinLayout layout, const CapeSett
             Pose{offset + capeStartPlacement(kind).position, capeStartPlacement(kind).rotation}),
       offset_(offset) {
   if (!cape_.ok()) return;
+  if (layout == PinLayout::Gathered) {
+    // Gathered onto the collar from the start, as cape_walk starts it (BulletScene::startCape): the top row
+    // on its pins, not flat at its full width and snapped onto them by the first step.
+    const Pose start = capeStartPlacement(kind);
+    const Pose placement{offset + start.position, start.rotation};
+    const Points& rest = rig_.fabric->restPositions();
+    Points& x = cape_.mutableState().positions;
+    for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+      const Vec3 local = rest.row(i).transpose();
+      x.row(i) = placement
+                     .apply(kind == SceneKind::Hang ? gatheredLevelPoint(local, CapeSize(), CollarShape())
+                                                    : gatheredPoint(local, CapeSize(), CollarShape()))
+                     .transpose();
+    }
+  }
   body_.moveTo(motionAt(motion_, 0.0), true);
   const Pose frame = [&] {
     BodyPose b = motionAt(motion_, 0.0);

@@ -165,6 +165,31 @@ TEST(Scenes, AGatheredCapeStartingLevelHasItsTopRowOnTheCollarPins) {
     }
 }
 
+// SimpleScene starts a gathered cape as cape_walk does: its top row on the collar pins (gatheredPoint, or
+// gatheredLevelPoint for the hang), where it used to start flat at its full width, 12 cm from its end pins,
+// and the first step snapped it onto the collar.
+TEST(Scenes, ASimpleSceneStartsAGatheredCapeOnItsPins) {
+  for (const SceneKind kind : {SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind}) {
+    const Vec3 offset(3.0f, 0.0f, -2.0f);
+    SimpleScene scene(kind, 20, PinLayout::Gathered, CapeSettings(), offset);
+    ASSERT_TRUE(scene.status().ok());
+    const Points& x = scene.cape().state().positions;
+    float miss = 0.0f;
+    for (const Pin& pin : scene.cape().state().pins)
+      miss = std::max(miss, (x.row(pin.particle).transpose() - pin.target).norm());
+    EXPECT_LT(miss, 1e-5f) << toString(kind);
+    // Gathered across, not stretched along: the end columns at their rest spacing below the top 6 cm, where
+    // gatheredPoint bends the collar's wrap out (the level start has none).
+    const Points& rest = scene.rig().fabric->restPositions();
+    for (int col = 0; col < 20; col += 19)
+      for (int row = kind == SceneKind::Hang ? 0 : 2; row + 1 < 20; ++row) {
+        const Eigen::Index a = row * 20 + col, b = (row + 1) * 20 + col;
+        EXPECT_NEAR((x.row(b) - x.row(a)).norm(), (rest.row(b) - rest.row(a)).norm(), 1e-5f)
+            << toString(kind) << " column " << col << " row " << row;
+      }
+  }
+}
+
 TEST(Metrics, FoldMeterMeasuresDihedralAnglesAndTheirChange) {
   const CapeRig rig = makeCapeRig(5, PinLayout::Corners);  // 5 x 5: 16 cells, 32 triangles
   const Fabric& f = *rig.fabric;
