@@ -394,6 +394,26 @@ TEST(SelfCollision, TheSearchScratchIsAllocatedAtTheFirstSearch) {
   EXPECT_EQ(self.scratchBytes(), first);
 }
 
+// A cape holds the scratch only with self-collision on, and gets it when it is turned on, not at a step.
+TEST(SelfCollision, ACapeHoldsTheSearchScratchOnlyWithSelfCollisionOn) {
+  CapeSettings off = test::quietSettings();
+  Cape cape(test::makeGrid(20, 20), off);
+  ASSERT_TRUE(cape.ok());
+  for (int f = 0; f < 5; ++f) cape.step(1.0f / 60.0f, {});
+  EXPECT_EQ(cape.selfCollisionScratchBytes(), 0u);
+  CapeSettings on = off;
+  on.selfCollision = true;
+  ASSERT_TRUE(cape.setSettings(on).ok());
+  const std::size_t bytes = cape.selfCollisionScratchBytes();
+  EXPECT_GT(bytes, 400u * 32u * sizeof(Cape::SelfContact));
+  EXPECT_EQ(cape.selfContactSearches(), 0u);
+  for (int f = 0; f < 5; ++f) cape.step(1.0f / 60.0f, {});
+  EXPECT_GT(cape.selfContactSearches(), 0u);
+  EXPECT_EQ(cape.selfCollisionScratchBytes(), bytes);
+  Cape born(test::makeGrid(20, 20), on);
+  EXPECT_EQ(born.selfCollisionScratchBytes(), bytes);
+}
+
 TEST(SelfCollision, NeighboursAreNeverContactsOnAFlatCape) {
   CapeSettings s;
   s.selfCollision = true;

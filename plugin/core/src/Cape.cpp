@@ -111,6 +111,7 @@ Cape::Cape(FabricPtr fabric, const CapeSettings& settings, const Pose& placement
   reference_.rotation.normalize();
   pinnedComponent_.assign(fabric_->componentCount(), 0);
   work_ = std::make_unique<detail::CapeScratch>(*fabric_);
+  if (settings_.selfCollision) work_->self.allocate();  // stepping never allocates
   work_->startPositions = state_.positions;
   animated_ = state_.positions;
   animatedNormals_ = Points::Zero(n, 3);
@@ -235,6 +236,10 @@ const std::vector<Cape::SelfContact>& Cape::selfContacts() const {
   return work_ ? work_->self.contacts() : none;
 }
 
+std::size_t Cape::selfCollisionScratchBytes() const {
+  return work_ ? work_->self.scratchBytes() : 0;
+}
+
 std::uint64_t Cape::selfContactSearches() const {
   return work_ ? work_->self.searches() : 0;
 }
@@ -252,6 +257,8 @@ Status Cape::setSettings(const CapeSettings& settings) {
   if (Status stable = checkExplicitStability(settings, massScale_, stiffnessScale_); !stable.ok())
     return stable;
   settings_ = settings;
+  // The self-contact search's scratch, the first time self-collision is on (stepping never allocates).
+  if (settings_.selfCollision && work_) work_->self.allocate();
   wake();
   // The coarse level keeps the settings it has if it refuses these (only the explicit integrator's
   // stability check can, and its longer springs are the more stable).

@@ -241,6 +241,7 @@ void SelfCollision::allocate() {
   sweptHi_ = Points::Zero(static_cast<Eigen::Index>(n), 3);
   stepMotionNorm_ = Eigen::VectorXf::Zero(static_cast<Eigen::Index>(n));
   contacts_.reserve(32 * n);
+  buildEdgePairs();
 }
 
 std::size_t SelfCollision::scratchBytes() const {
@@ -478,7 +479,6 @@ void SelfCollision::buildEdgePairs() {
   // Every edge of two triangles (a, b, c) and (b, a, d) is a hinge, and its quad a-c-b-d has two pairs of
   // opposite edges, (a c, b d) and (b c, a d). Visited from both triangles: kept from the one whose own
   // corner is the lower index.
-  edgePairsBuilt_ = true;
   const std::vector<std::uint32_t>& tri = fabric_.triangles();
   const std::vector<TriangleLocalSet>& local = fabric_.triangleLocal();
   for (std::size_t t = 0; t < fabric_.triangleCount(); ++t)
@@ -502,7 +502,6 @@ void SelfCollision::findEdges(const Points& x) {
   // the slack plus their relative predicted motion. The edge thickness is a fifth of the particle one
   // (kEdgeThicknessFraction): a clean fold's opposite edges lie about half as far apart as its layers, and
   // a gathered collar's pleats closer still, which twice that held open (docs/SOLVER.md).
-  if (!edgePairsBuilt_) buildEdgePairs();
   const float edgeThickness = kEdgeThicknessFraction * thickness_;
   const float* norm = stepMotionNorm_.data();
   const float *px = x.col(0).data(), *py = x.col(1).data(), *pz = x.col(2).data();

@@ -73,16 +73,17 @@ class SelfCollision {
   }
 
   const std::vector<Cape::SelfContact>& contacts() const { return contacts_; }
-  /// Every hinge's two pairs of opposite edges (built at the first search; empty before).
+  /// Every hinge's two pairs of opposite edges (built with the scratch, allocate(); empty before).
   const std::vector<EdgePair>& edgePairs() const { return edgePairs_; }
   const std::vector<EdgeContact>& edgeContacts() const { return edgeContacts_; }
   std::uint64_t searches() const { return searches_; }
-  /// Bytes held by the search's scratch: none until the first search.
+  /// Bytes held by the search's scratch: none until allocate() or the first search.
   std::size_t scratchBytes() const;
+  /// Sizes the search's scratch (once; a search does it if nothing has): Cape calls it when self-collision
+  /// is turned on, so that its steps never allocate.
+  void allocate();
 
  private:
-  /// Sizes the search's scratch, at the first search.
-  void allocate();
   float predictMotion(const CapeState& state, const Eigen::VectorXf& freeMask, const Vec3& gravity, float dt);
   void find(const Points& x, const Points& v, float thickness);
   /// Bins every cluster's grown box into the hash (find's first half).
@@ -105,7 +106,6 @@ class SelfCollision {
   const Fabric& fabric_;
   std::vector<Cape::SelfContact> contacts_;
   std::vector<EdgePair> edgePairs_;
-  bool edgePairsBuilt_ = false;
   std::vector<float> edgeAxis_;  ///< Per edge pair: the unit direction that last separated its edges.
   std::vector<EdgeContact> edgeContacts_;
   double validUntil_ = -1.0;    ///< s: the contacts cover the motion until this time.

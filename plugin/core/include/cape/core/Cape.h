@@ -263,6 +263,9 @@ class CAPE_CORE_API Cape {
   std::size_t selfContactCount() const { return selfContacts().size(); }
   /// Self-contact searches run so far (a search's contacts are kept over the steps its margin covers).
   std::uint64_t selfContactSearches() const;
+  /// Bytes held by the self-contact search's scratch: none until self-collision is first turned on (at
+  /// construction or by setSettings), so a crowd of capes without it does not pay for it.
+  std::size_t selfCollisionScratchBytes() const;
 
   /// Sum over particles of kinetic and gravitational potential energy plus spring (Hooke) energy, J.
   double energy() const;
