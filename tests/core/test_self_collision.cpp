@@ -347,6 +347,23 @@ TEST(SelfCollision, AHingeFoldedOnDoesNotCrossItsOppositeEdges) {
   EXPECT_LT(free.separation(), 0.0f);
 }
 
+/// A flat 20 x 20 grid at rest and its own search, with self-collision on.
+struct FlatGridSearch {
+  FlatGridSearch() : grid(test::makeGrid(20, 20)), self(*grid) {
+    state.positions = grid->restPositions();
+    state.velocities = Points::Zero(state.positions.rows(), 3);
+    settings.selfCollision = true;
+    free = Eigen::VectorXf::Ones(state.positions.rows());
+  }
+  /// One 1/60 s step of 4 substeps' schedule (SelfCollision::schedule).
+  int schedule() { return self.schedule(state, free, settings, 1.0f / 60.0f, 4); }
+  FabricPtr grid;
+  detail::SelfCollision self;
+  CapeState state;
+  CapeSettings settings;
+  Eigen::VectorXf free;
+};
+
 // An open hinge's opposite edges are out of reach: a flat grid has no edge-edge contacts, and neither has a
 // hinge folded by a right angle.
 TEST(SelfCollision, OpenHingesAreNoEdgeContacts) {
@@ -356,42 +373,28 @@ TEST(SelfCollision, OpenHingesAreNoEdgeContacts) {
     EXPECT_EQ(open.edgeContacts, 0u) << degrees << " degrees";
   }
   // Every hinge of a grid has two pairs of opposite edges: 20 x 20 has 19 * 19 * 3 - 2 * 19 interior edges.
-  FabricPtr grid = test::makeGrid(20, 20);
-  detail::SelfCollision self(*grid);
-  CapeState state;
-  state.positions = grid->restPositions();
-  state.velocities = Points::Zero(state.positions.rows(), 3);
-  CapeSettings settings;
-  settings.selfCollision = true;
-  const Eigen::VectorXf free = Eigen::VectorXf::Ones(state.positions.rows());
-  EXPECT_EQ(self.schedule(state, free, settings, 1.0f / 60.0f, 4), 0);
-  EXPECT_EQ(self.edgePairs().size(), 2u * (19u * 19u * 3u - 2u * 19u));
-  EXPECT_TRUE(self.edgeContacts().empty());
+  FlatGridSearch flat;
+  EXPECT_EQ(flat.schedule(), 0);
+  EXPECT_EQ(flat.self.edgePairs().size(), 2u * (19u * 19u * 3u - 2u * 19u));
+  EXPECT_TRUE(flat.self.edgeContacts().empty());
 }
 
 // A cape keeps the search's scratch only once it searches: a crowd of capes without self-collision holds
 // none of it. Sized at the first search, and not grown by the next ones on the same cape.
 TEST(SelfCollision, TheSearchScratchIsAllocatedAtTheFirstSearch) {
-  FabricPtr grid = test::makeGrid(20, 20);
-  detail::SelfCollision self(*grid);
-  EXPECT_EQ(self.scratchBytes(), 0u);
-  CapeState state;
-  state.positions = grid->restPositions();
-  state.velocities = Points::Zero(state.positions.rows(), 3);
-  CapeSettings settings;
-  settings.selfCollision = true;
-  const Eigen::VectorXf free = Eigen::VectorXf::Ones(state.positions.rows());
-  EXPECT_EQ(self.schedule(state, free, settings, 1.0f / 60.0f, 4), 0);
-  const std::size_t first = self.scratchBytes();
+  FlatGridSearch flat;
+  EXPECT_EQ(flat.self.scratchBytes(), 0u);
+  EXPECT_EQ(flat.schedule(), 0);
+  const std::size_t first = flat.self.scratchBytes();
   // At least the contacts' reserve (32 per particle) and the hash (two buckets per particle).
   EXPECT_GE(first, 400u * (32u * sizeof(Cape::SelfContact) + 2u * sizeof(std::uint32_t)));
   for (int f = 1; f <= 10; ++f) {
-    state.time = f / 60.0;
-    state.positions.col(1).array() -= 0.001f * static_cast<float>(f);
-    EXPECT_EQ(self.schedule(state, free, settings, 1.0f / 60.0f, 4), 0);
+    flat.state.time = f / 60.0;
+    flat.state.positions.col(1).array() -= 0.001f * static_cast<float>(f);
+    EXPECT_EQ(flat.schedule(), 0);
   }
-  EXPECT_EQ(self.searches(), 11u);
-  EXPECT_EQ(self.scratchBytes(), first);
+  EXPECT_EQ(flat.self.searches(), 11u);
+  EXPECT_EQ(flat.self.scratchBytes(), first);
 }
 
 // A cape holds the scratch only with self-collision on, and gets it when it is turned on, not at a step.
