@@ -218,8 +218,8 @@ bool closestOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec
 SelfCollision::SelfCollision(const Fabric& fabric) : fabric_(fabric) {}
 
 void SelfCollision::allocate() {
-  // The search's scratch, sized once at the first search: a cape that never turns self-collision on keeps
-  // none of it (a 20 x 20 cape's is about 270 kB, most of it the contacts' reserve).
+  // The search's scratch, sized once, when the cape turns self-collision on (or at the first search): a cape
+  // that never does keeps none of it (a 20 x 20 cape's is about 270 kB, most of it the contacts' reserve).
   if (allocated_) return;
   allocated_ = true;
   const std::size_t n = fabric_.particleCount(), triangles = fabric_.triangleCount();
