@@ -459,7 +459,7 @@ void BulletScene::placeCape(Character& c) {
 
 void BulletScene::startCape(int character, bullet::CapeAction& action) const {
   if (options_.pinLayout != PinLayout::Gathered) return;
-  // The grid's rest points gathered onto the collar (gatheredPoint, in the grid's frame), placed as the
+  // The grid's rest points gathered onto the collar (gatheredStartPoint, in the grid's frame), placed as the
   // cape is (relative to the scene's origin), and written in the cape's frame (in double: the frame may be
   // far from the world's origin).
   const Pose& placement = characters_[static_cast<std::size_t>(character)]->placement;
@@ -467,11 +467,9 @@ void BulletScene::startCape(int character, bullet::CapeAction& action) const {
   Cape& cape = action.cape();
   const Points& rest = cape.fabric().restPositions();
   Points& x = cape.mutableState().positions;
-  const bool level = options_.scene == SceneKind::Hang;  // starts sticking out behind: capeStartPlacement
   for (Eigen::Index i = 0; i < rest.rows(); ++i) {
-    const Vec3 local = rest.row(i).transpose();
-    const Vec3 at = placement.apply(level ? gatheredLevelPoint(local, capeSize_, collar_)
-                                          : gatheredPoint(local, capeSize_, collar_));
+    const Vec3 at =
+        placement.apply(gatheredStartPoint(options_.scene, rest.row(i).transpose(), capeSize_, collar_));
     x.row(i) = (at.cast<double>() + shift).cast<float>().transpose();
   }
 }

@@ -220,6 +220,11 @@ Vec3 gatheredLevelPoint(const Vec3& local, const CapeSize& size, const CollarSha
               local.z());
 }
 
+Vec3 gatheredStartPoint(SceneKind kind, const Vec3& local, const CapeSize& size, const CollarShape& collar) {
+  return kind == SceneKind::Hang ? gatheredLevelPoint(local, size, collar)
+                                 : gatheredPoint(local, size, collar);
+}
+
 CapeRig makeCapeRig(int n, PinLayout layout, bool bendSprings, const CapeSize& size, int rows,
                     float totalMass, const CollarShape& collar) {
   CapeRig rig;
@@ -280,13 +285,9 @@ SimpleScene::SimpleScene(SceneKind kind, int n, PinLayout layout, const CapeSett
     const Pose placement{offset + start.position, start.rotation};
     const Points& rest = rig_.fabric->restPositions();
     Points& x = cape_.mutableState().positions;
-    for (Eigen::Index i = 0; i < rest.rows(); ++i) {
-      const Vec3 local = rest.row(i).transpose();
-      x.row(i) = placement
-                     .apply(kind == SceneKind::Hang ? gatheredLevelPoint(local, CapeSize(), CollarShape())
-                                                    : gatheredPoint(local, CapeSize(), CollarShape()))
+    for (Eigen::Index i = 0; i < rest.rows(); ++i)
+      x.row(i) = placement.apply(gatheredStartPoint(kind, rest.row(i).transpose(), CapeSize(), CollarShape()))
                      .transpose();
-    }
   }
   body_.moveTo(motionAt(motion_, 0.0), true);
   const Pose frame = [&] {

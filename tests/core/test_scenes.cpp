@@ -165,9 +165,9 @@ TEST(Scenes, AGatheredCapeStartingLevelHasItsTopRowOnTheCollarPins) {
     }
 }
 
-// SimpleScene starts a gathered cape as cape_walk does: its top row on the collar pins (gatheredPoint, or
-// gatheredLevelPoint for the hang), where it used to start flat at its full width, 12 cm from its end pins,
-// and the first step snapped it onto the collar.
+// SimpleScene starts a gathered cape as cape_walk does: its top row on the collar pins (gatheredStartPoint),
+// where it used to start flat at its full width, 8.5 cm from its end pins, and the first step snapped it
+// onto the collar.
 TEST(Scenes, ASimpleSceneStartsAGatheredCapeOnItsPins) {
   for (const SceneKind kind : {SceneKind::Hang, SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind}) {
     const Vec3 offset(3.0f, 0.0f, -2.0f);

@@ -379,8 +379,8 @@ TEST(SelfCollision, OpenHingesAreNoEdgeContacts) {
   EXPECT_TRUE(flat.self.edgeContacts().empty());
 }
 
-// A cape keeps the search's scratch only once it searches: a crowd of capes without self-collision holds
-// none of it. Sized at the first search, and not grown by the next ones on the same cape.
+// The search sizes its scratch at its first search if nothing has (Cape does it when self-collision is
+// turned on), and the next searches on the same cape do not grow it.
 TEST(SelfCollision, TheSearchScratchIsAllocatedAtTheFirstSearch) {
   FlatGridSearch flat;
   EXPECT_EQ(flat.self.scratchBytes(), 0u);

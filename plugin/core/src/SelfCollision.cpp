@@ -137,6 +137,9 @@ inline bool boxesOverlap(const float* qlo, const float* qhi, const float* lo, co
          (qlo[2] <= hi[2]);
 }
 
+/// The empty box's corners (any finite box's union with it is itself).
+constexpr float kHuge = std::numeric_limits<float>::max();
+
 /// How far segment p0-p1's projection onto unit axis u lies above q0-q1's (negative where they overlap): at
 /// most the segments' distance, for any unit u.
 inline float separationAlong(const Vec3& u, const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
@@ -220,8 +223,7 @@ SelfCollision::SelfCollision(const Fabric& fabric) : fabric_(fabric) {}
 void SelfCollision::allocate() {
   // The search's scratch, sized once, when the cape turns self-collision on (or at the first search): a cape
   // that never does keeps none of it (a 20 x 20 cape's is about 270 kB, most of it the contacts' reserve).
-  if (allocated_) return;
-  allocated_ = true;
+  if (!hashStart_.empty()) return;  // sized already (the hash's offsets are never empty once sized)
   const std::size_t n = fabric_.particleCount(), triangles = fabric_.triangleCount();
   // A hash of at least twice as many buckets as particles (a power of two).
   std::uint32_t buckets = 1;
@@ -361,19 +363,29 @@ CAPE_ALWAYS_INLINE inline bool SelfCollision::particleFull() const {
   return contacts_.size() - particleFirst_ >= kMaxContactsPerParticle;
 }
 
+CAPE_ALWAYS_INLINE inline void SelfCollision::growCornerBox(std::uint32_t t, float* lo, float* hi) const {
+  const std::vector<std::uint32_t>& tri = fabric_.triangles();
+  const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
+  for (int k = 0; k < 3; ++k) {
+    const float* l = sweptLo_.col(k).data();
+    const float* h = sweptHi_.col(k).data();
+    lo[k] = std::min(lo[k], std::min(std::min(l[ia], l[ib]), l[ic]));
+    hi[k] = std::max(hi[k], std::max(std::max(h[ia], h[ib]), h[ic]));
+  }
+}
+
 void SelfCollision::grownBox(std::uint32_t t, Vec3& lo, Vec3& hi) const {
   // The box a triangle sweeps over the search's window, its corners moving by their predicted motion (less
   // the cape's rigid motion), grown by the thickness and the slack: a particle that comes within the
   // thickness of it at some moment of the window is then in this box, and the particle's own swept box
-  // overlaps it. As binned, and for the rare unbinned paths.
-  const std::vector<std::uint32_t>& tri = fabric_.triangles();
-  const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
+  // overlaps it. As binned (bin() grows a cluster's union once: a rounded subtraction of one amount keeps
+  // the order, so the same bits), and for the rare unbinned paths.
+  float l[3] = {kHuge, kHuge, kHuge}, h[3] = {-kHuge, -kHuge, -kHuge};
+  growCornerBox(t, l, h);
   const float grow = thickness_ + slack_;
   for (int k = 0; k < 3; ++k) {
-    const float* l = sweptLo_.col(k).data();
-    const float* h = sweptHi_.col(k).data();
-    lo[k] = std::min({l[ia], l[ib], l[ic]}) - grow;
-    hi[k] = std::max({h[ia], h[ib], h[ic]}) + grow;
+    lo[k] = l[k] - grow;
+    hi[k] = h[k] + grow;
   }
 }
 
@@ -632,26 +644,15 @@ void SelfCollision::bin() {
   std::fill(hashStart_.begin(), hashStart_.end(), 0u);
   std::fill(bucketCluster_.begin(), bucketCluster_.end(), ~0u);
   const std::size_t clusters = fabric_.clusterCount();
-  // The union of a cluster's grown boxes is its corners' swept boxes' union, grown once (a rounded
-  // subtraction of the same amount keeps the order: the same bits as growing each triangle's box).
+  // A cluster's box: the union of its triangles' grown boxes (grownBox), grown once.
   const float grow = thickness_ + slack_;
   const float* norm = stepMotionNorm_.data();
-  const float *lx = sweptLo_.col(0).data(), *ly = sweptLo_.col(1).data(), *lz = sweptLo_.col(2).data();
-  const float *hx = sweptHi_.col(0).data(), *hy = sweptHi_.col(1).data(), *hz = sweptHi_.col(2).data();
   for (std::size_t g = 0; g < clusters; ++g) {
     clusterBucketStart_[g] = static_cast<std::uint32_t>(clusterBuckets_.size());
-    float lo[3], hi[3];
-    lo[0] = lo[1] = lo[2] = std::numeric_limits<float>::max();
-    hi[0] = hi[1] = hi[2] = -std::numeric_limits<float>::max();
+    float lo[3] = {kHuge, kHuge, kHuge}, hi[3] = {-kHuge, -kHuge, -kHuge};
     for (std::uint32_t t = clusterStart[g]; t < clusterStart[g + 1]; ++t) {
-      const std::uint32_t ia = tri[3 * t], ib = tri[3 * t + 1], ic = tri[3 * t + 2];
-      triangleMotion_[t] = std::max(std::max(norm[ia], norm[ib]), norm[ic]);
-      lo[0] = std::min(lo[0], std::min(std::min(lx[ia], lx[ib]), lx[ic]));
-      lo[1] = std::min(lo[1], std::min(std::min(ly[ia], ly[ib]), ly[ic]));
-      lo[2] = std::min(lo[2], std::min(std::min(lz[ia], lz[ib]), lz[ic]));
-      hi[0] = std::max(hi[0], std::max(std::max(hx[ia], hx[ib]), hx[ic]));
-      hi[1] = std::max(hi[1], std::max(std::max(hy[ia], hy[ib]), hy[ic]));
-      hi[2] = std::max(hi[2], std::max(std::max(hz[ia], hz[ib]), hz[ic]));
+      triangleMotion_[t] = std::max(std::max(norm[tri[3 * t]], norm[tri[3 * t + 1]]), norm[tri[3 * t + 2]]);
+      growCornerBox(t, lo, hi);
     }
     for (int k = 0; k < 3; ++k) {
       lo[k] -= grow;

@@ -94,6 +94,8 @@ class SelfCollision {
   /// Particle q against triangle t: the exact filter, and the contact if within reach.
   void consider(std::uint32_t q, const Vec3& p, std::uint32_t t, bool stamp);
   void grownBox(std::uint32_t t, Vec3& lo, Vec3& hi) const;
+  /// Grows lo..hi (3 floats each) to take in triangle t's corners' swept boxes.
+  void growCornerBox(std::uint32_t t, float* lo, float* hi) const;
   /// Whether the particle being scanned has as many contacts as a search keeps for one.
   bool particleFull() const;
   /// The hinges' opposite edges within reach (find's last part).
@@ -112,7 +114,6 @@ class SelfCollision {
   std::uint64_t searches_ = 0;  ///< Searches so far (diagnostics).
 
   // The search's scratch, sized once (allocate()).
-  bool allocated_ = false;
   std::vector<std::uint32_t> hashStart_;  ///< Spatial hash: bucket offsets (buckets + 1).
   /// A cluster of triangles in a bucket of the spatial hash, with its grown box inline: the search reads
   /// entries in order and rejects most by the box without touching the triangles.

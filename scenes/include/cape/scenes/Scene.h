@@ -124,6 +124,11 @@ CAPE_SCENES_API Vec3 gatheredPoint(const Vec3& local, const CapeSize& size, cons
 /// gatheredPoint's does under the walk's (the pins of makeCapeRig's Gathered layout), and every column
 /// starts straight and at its rest length.
 CAPE_SCENES_API Vec3 gatheredLevelPoint(const Vec3& local, const CapeSize& size, const CollarShape& collar);
+/// Where a point of the grid starts in scene `kind` when the cape is gathered onto `collar`:
+/// gatheredLevelPoint for the hang, which starts the cape level behind the collar (capeStartPlacement),
+/// gatheredPoint otherwise.
+CAPE_SCENES_API Vec3 gatheredStartPoint(SceneKind kind, const Vec3& local, const CapeSize& size,
+                                        const CollarShape& collar);
 
 /// Character-frame attachment points: "corners" pins the top corners at (+-0.30, 1.56, 0.15); "collar" pins
 /// the whole top row along the same line; "gathered" pins the whole top row on `collar` (gatheredPoint).
