@@ -552,21 +552,59 @@ bool RunRenderer::finish(std::string& error) {
 
 namespace {
 
-/// The area the cape's front triangles cover in the camera's image, px^2 (overlaps counted twice).
-double projectedArea(const CapeMesh& mesh, const Camera& camera) {
-  const std::size_t front = mesh.twoSided() ? mesh.indices.size() / 2 : mesh.indices.size();
-  double area = 0.0;
-  for (std::size_t t = 0; t + 2 < front; t += 3) {
-    Eigen::Vector2f p[3];
-    bool seen = true;
-    for (int i = 0; i < 3 && seen; ++i)
-      seen =
-          camera.project(mesh.positions.row(mesh.indices[t + static_cast<std::size_t>(i)]).transpose(), p[i]);
-    if (!seen) continue;
-    const Eigen::Vector2f a = p[1] - p[0], b = p[2] - p[0];
-    area += 0.5 * std::fabs(static_cast<double>(a.x()) * b.y() - static_cast<double>(a.y()) * b.x());
+/// The area of the camera's image the capes' front triangles cover, px^2: their union on a grid of
+/// kCoverageCell-pixel cells (a cell counts when its centre is inside a triangle), so a cape folded or
+/// twisted over itself counts once, as the picture shows it. `mask` is scratch.
+constexpr int kCoverageCell = 4;
+double coveredArea(const std::vector<const CapeMesh*>& meshes, const Camera& camera,
+                   std::vector<std::uint8_t>& mask) {
+  const int columns = (camera.width + kCoverageCell - 1) / kCoverageCell;
+  const int rows = (camera.height + kCoverageCell - 1) / kCoverageCell;
+  mask.assign(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows), 0);
+  std::size_t covered = 0;
+  for (const CapeMesh* mesh : meshes) {
+    if (mesh == nullptr) continue;
+    const std::size_t front = mesh->twoSided() ? mesh->indices.size() / 2 : mesh->indices.size();
+    for (std::size_t t = 0; t + 2 < front; t += 3) {
+      Eigen::Vector2f p[3];
+      bool seen = true;
+      for (int i = 0; i < 3 && seen; ++i)
+        seen = camera.project(mesh->positions.row(mesh->indices[t + static_cast<std::size_t>(i)]).transpose(),
+                              p[i]);
+      if (!seen) continue;
+      // In cell units, relative to the panel; the cells whose centres the triangle's box holds.
+      for (Eigen::Vector2f& q : p)
+        q = (q - Eigen::Vector2f(static_cast<float>(camera.x), static_cast<float>(camera.y))) / kCoverageCell;
+      const float area2 = (p[1] - p[0]).x() * (p[2] - p[0]).y() - (p[1] - p[0]).y() * (p[2] - p[0]).x();
+      if (!(std::fabs(area2) > 0.0f)) continue;
+      const float lo[2] = {std::min({p[0].x(), p[1].x(), p[2].x()}),
+                           std::min({p[0].y(), p[1].y(), p[2].y()})};
+      const float hi[2] = {std::max({p[0].x(), p[1].x(), p[2].x()}),
+                           std::max({p[0].y(), p[1].y(), p[2].y()})};
+      const int x0 = std::max(0, static_cast<int>(std::ceil(lo[0] - 0.5f)));
+      const int x1 = std::min(columns - 1, static_cast<int>(std::floor(hi[0] - 0.5f)));
+      const int y0 = std::max(0, static_cast<int>(std::ceil(lo[1] - 0.5f)));
+      const int y1 = std::min(rows - 1, static_cast<int>(std::floor(hi[1] - 0.5f)));
+      const float sign = area2 > 0.0f ? 1.0f : -1.0f;
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+          const Eigen::Vector2f c(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+          bool inside = true;
+          for (int e = 0; e < 3 && inside; ++e) {
+            const Eigen::Vector2f& a = p[e];
+            const Eigen::Vector2f& b = p[(e + 1) % 3];
+            inside = sign * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x()) >= 0.0f;
+          }
+          std::uint8_t& cell = mask[static_cast<std::size_t>(y) * static_cast<std::size_t>(columns) +
+                                    static_cast<std::size_t>(x)];
+          if (inside && cell == 0) {
+            cell = 1;
+            ++covered;
+          }
+        }
+    }
   }
-  return area;
+  return static_cast<double>(covered) * kCoverageCell * kCoverageCell;
 }
 
 }  // namespace
@@ -640,10 +678,7 @@ void RunMovie::record(std::int64_t frame, int character, const CapeMesh& mesh,
   {
     // Before pictureFrom_ the latest frame is kept (the picture of a run that ends early); from then on the
     // one that shows the most cape.
-    double score = 0.0;
-    if (frame >= pictureFrom_)
-      for (const CapeMesh* m : meshes_)
-        if (m) score += projectedArea(*m, camera_.camera());
+    const double score = frame >= pictureFrom_ ? coveredArea(meshes_, camera_.camera(), coverage_) : 0.0;
     if (frame < pictureFrom_ || best_.frame < pictureFrom_ || score > best_.score) {
       best_.frame = frame;
       best_.score = score;

@@ -243,7 +243,7 @@ class RunMovie {
  private:
   struct Still {
     std::int64_t frame = 0;
-    double score = -1.0;  ///< projected cape area, px^2 of the video's image
+    double score = -1.0;  ///< the area of the video's image the capes cover, px^2
     std::vector<CapeMesh> meshes;
     std::vector<std::vector<Collider>> colliders;
     FollowCamera camera;
@@ -262,6 +262,7 @@ class RunMovie {
   std::vector<const CapeMesh*> meshes_;
   std::vector<std::vector<Collider>> colliders_;
   Still best_;
+  std::vector<std::uint8_t> coverage_;  ///< coveredArea's scratch
   int videoFrames_ = 0;
   double renderMs_ = 0.0;
 };

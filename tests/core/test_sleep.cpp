@@ -166,6 +166,29 @@ TEST(Sleep, ASwingingCapeStaysAwake) {
   EXPECT_EQ(h.cape.sleptSteps(), 0u);
 }
 
+// A large cape hanging from its corners rests above the strain limit on the settings' substeps and well
+// below half of it on twice as many: the refinement's halving bounced back and forth for as long as it hung,
+// each switch shaking it, and it never fell asleep (48 x 48: particles at 0.2 to 0.5 m/s after 30 s). A
+// halving that bounces now makes the next one wait, twice as long each time: the switches die out and the
+// cape settles, on the finer substeps, and sleeps.
+TEST(Sleep, ALargeCapeAtRestSettlesItsRefinementAndFallsAsleep) {
+  SimpleScene scene(SceneKind::Hang, 48, PinLayout::Corners,
+                    settingsForScene(SceneKind::Hang, CapeSettings()));
+  ASSERT_TRUE(scene.status().ok());
+  int switches = 0, lateSwitches = 0, refinement = scene.cape().substepRefinement();
+  for (int f = 0; f < 900 && !scene.cape().isAsleep(); ++f) {
+    scene.advanceFrame();
+    if (scene.cape().substepRefinement() != refinement) {
+      ++switches;
+      if (f >= 300) ++lateSwitches;
+      refinement = scene.cape().substepRefinement();
+    }
+  }
+  EXPECT_TRUE(scene.cape().isAsleep()) << switches << " switches of the refinement";
+  EXPECT_LE(lateSwitches, 4) << "switches after 5 s";
+  EXPECT_TRUE(scene.cape().state().positions.allFinite());
+}
+
 TEST(Sleep, SettingsAreChecked) {
   CapeSettings s;
   s.sleepSpeed = -1.0f;

@@ -22,12 +22,12 @@ struct StoredScene {
 // 20 x 20 canonical cape, corner attachment, default settings, 180 frames of 1/60 s (a sprint-turn's first
 // turn is in frames 90..120).
 constexpr StoredScene kStored[] = {
-    {SceneKind::Hang, false, 0x36e983342aa5d54bull},
-    {SceneKind::Hang, true, 0x36e983342aa5d54bull},
+    {SceneKind::Hang, false, 0xa3645b1981244dbeull},
+    {SceneKind::Hang, true, 0xa3645b1981244dbeull},
     {SceneKind::Walk, false, 0x5faab71c43d1e6baull},
     {SceneKind::Walk, true, 0x5faab71c43d1e6baull},
-    {SceneKind::SprintTurn, false, 0xa2b1ed84dc23402aull},
-    {SceneKind::SprintTurn, true, 0x98b200c28124e571ull},
+    {SceneKind::SprintTurn, false, 0x2fcd9ebd0d75753dull},
+    {SceneKind::SprintTurn, true, 0x59156db563773d5cull},
     {SceneKind::Wind, false, 0x7132717a08c6698aull},
     {SceneKind::Wind, true, 0x6fafb93a52a5ffc7ull},
 };

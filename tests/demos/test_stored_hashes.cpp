@@ -23,20 +23,20 @@ struct StoredRun {
 #ifdef BT_USE_DOUBLE_PRECISION
 constexpr StoredRun kStored[] = {
     {"--cape canonical --scene walk", "37767701094250be"},
-    {"--cape canonical --scene sprint-turn --self-collision", "219d452d1fb3c51d"},
+    {"--cape canonical --scene sprint-turn --self-collision", "7267b9d4a6c51b08"},
     {"--cape canonical --simple-body --scene walk", "7e841931b51c1c66"},
-    {"--cape canonical --simple-body --scene sprint-turn --self-collision", "dfcf10d4c7748c1b"},
-    {"--scene walk", "5ed6f176cefa5f64"},
-    {"--scene sprint-turn", "d37721ee5891ea0c"},
+    {"--cape canonical --simple-body --scene sprint-turn --self-collision", "dbb0e517e32cd469"},
+    {"--scene walk", "c1f51535356403a9"},
+    {"--scene sprint-turn", "9363c6782bb3ba00"},
 };
 #else
 constexpr StoredRun kStored[] = {
     {"--cape canonical --scene walk", "d97b5bf769a22361"},
-    {"--cape canonical --scene sprint-turn --self-collision", "d80ddd74e7b20a8c"},
+    {"--cape canonical --scene sprint-turn --self-collision", "43f7aebbd2e3c59b"},
     {"--cape canonical --simple-body --scene walk", "5107e3ce3bf11888"},
-    {"--cape canonical --simple-body --scene sprint-turn --self-collision", "7f31809400315d25"},
-    {"--scene walk", "9665de51720970b2"},
-    {"--scene sprint-turn", "2bc0182d43c1cd4c"},
+    {"--cape canonical --simple-body --scene sprint-turn --self-collision", "75a0eb43f50e2214"},
+    {"--scene walk", "361e24ed6bd42a6b"},
+    {"--scene sprint-turn", "3c7e69d189fd7a82"},
 };
 #endif
 

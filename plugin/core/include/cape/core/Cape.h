@@ -302,7 +302,7 @@ class CAPE_CORE_API Cape {
   Status checkExplicitStability(const CapeSettings& settings, const Eigen::VectorXf& massScale,
                                 const Eigen::VectorXf& stiffnessScale) const;
   void solveTethers();
-  void adaptRefinement();
+  void adaptRefinement(float dt);
   /// Whether nothing the cape feels moves in this step (pins and colliders still, no wind).
   bool surroundingsStill(ColliderSpan colliders) const;
   void updateSleep(float dt, bool still, ColliderSpan colliders);
@@ -323,9 +323,12 @@ class CAPE_CORE_API Cape {
   bool coarseOn_ = false;
   bool steppedCoarse_ = false;
   std::array<float, kSpringFamilyCount> familyCompliance_{};  ///< 1 / stiffness per family, m/N (inf: off).
-  int substepOverride_ = 0;     ///< Substeps per timeStep in place of the settings' (0: none).
-  int refinement_ = 1;          ///< Substep multiplier of the next step (1, 2, 4, ...).
-  float lastMaxStrain_ = 0.0f;  ///< Max structural strain after the last step.
+  int substepOverride_ = 0;      ///< Substeps per timeStep in place of the settings' (0: none).
+  int refinement_ = 1;           ///< Substep multiplier of the next step (1, 2, 4, ...).
+  float halvingDelay_ = 0.0f;    ///< s after a doubling before refinement_ may halve (adaptRefinement).
+  float sinceHalving_ = 1e30f;   ///< s since refinement_ last halved.
+  float sinceDoubling_ = 1e30f;  ///< s since refinement_ last doubled.
+  float lastMaxStrain_ = 0.0f;   ///< Max structural strain after the last step.
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  ///< World position of the cape's frame, m.
   Pose reference_;                                    ///< The rest shape's pose in the frame.
   std::vector<std::uint8_t> pinnedComponent_;         ///< 1 for each fabric component holding a pin.

@@ -73,7 +73,11 @@ struct CAPE_CORE_API CapeSettings {
   /// three. Three per 1/60 s meet the walk scene's strain bounds (docs/SOLVER.md, "Choosing the integrator").
   int substeps = 3;
   /// Strain-adaptive substepping: when the max structural strain after a step exceeds this (0 = off), the
-  /// next steps take 2x, 4x ... up to maxRefinement times the substeps until it falls below half of it.
+  /// next steps take 2x, 4x ... up to maxRefinement times the substeps until it falls below half of it. A
+  /// halving that has to be undone within a second (the fewer substeps stretch the cape past the limit
+  /// again, as a large cape at rest does) makes the next halving wait until 1/8 s after the last doubling,
+  /// twice as long after each such bounce up to 16 s, so the substeps do not swing between two levels for
+  /// ever (docs/SOLVER.md, "One step").
   /// Meant for stiff cloth under violent motion: it keeps a sprint's 180-degree turn from overstretching the
   /// cape for a few times the cost and leaves walking unchanged (cost in docs/PERFORMANCE.md, strain in
   /// docs/COMPARISON.md); a deliberately stretchy cloth whose working strain is above the limit would pay the
