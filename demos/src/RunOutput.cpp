@@ -189,6 +189,7 @@ void FrameTimings::add(const FrameRow& row) {
   motionTimeUs_.add(row.motionTimeUs);
   const double whole = row.motionTimeUs + row.frameTimeUs;
   motionShare_.add(whole > 0.0 ? row.motionTimeUs / whole : 0.0);
+  metricsTimeUs_.add(row.metricsTimeUs);
 }
 
 json summaryFigures(const FrameTimings& timings, const RunSummary& q) {
@@ -225,6 +226,8 @@ json frameShareFigures(const FrameTimings& timings, int capes) {
   j["motion_time_us_median"] = timings.motionTimeUs().percentile(50.0);
   j["motion_time_us_p95"] = timings.motionTimeUs().percentile(95.0);
   j["motion_share_median"] = timings.motionShare().percentile(50.0);
+  j["metrics_time_us_median"] = timings.metricsTimeUs().percentile(50.0);
+  j["metrics_time_us_p95"] = timings.metricsTimeUs().percentile(95.0);
   return j;
 }
 

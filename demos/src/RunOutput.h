@@ -30,6 +30,8 @@ struct FrameRow {
   /// Wall time of moving the characters to the frame's pose before the step (the gait or a motion clip:
   /// forward kinematics and the kinematic bodies' transforms and velocities), not in frameTimeUs.
   double motionTimeUs = 0.0;
+  /// Wall time of the frame's metrics (every cape's FrameMeter::measure), after the step.
+  double metricsTimeUs = 0.0;
 };
 
 /// The cape's settings as written to summary.json and compare.json (units in the key names).
@@ -74,9 +76,10 @@ class FrameTimings {
   const PercentileEstimator& bulletTimeUs() const { return bulletTimeUs_; }
   const PercentileEstimator& motionTimeUs() const { return motionTimeUs_; }
   const PercentileEstimator& motionShare() const { return motionShare_; }  ///< per frame, 0..1
+  const PercentileEstimator& metricsTimeUs() const { return metricsTimeUs_; }
 
  private:
-  PercentileEstimator frameTimeUs_, capeTimeUs_, bulletTimeUs_, motionTimeUs_, motionShare_;
+  PercentileEstimator frameTimeUs_, capeTimeUs_, bulletTimeUs_, motionTimeUs_, motionShare_, metricsTimeUs_;
 };
 
 /// Summary figures of a run: its timings' median and p95 and the quality summary.
@@ -85,7 +88,8 @@ nlohmann::json summaryFigures(const FrameTimings& timings, const RunSummary& qua
 /// How a cape_walk frame divides: Bullet's own share (bullet_time_us_median, _p95), the cape time per
 /// cape (cape_time_per_cape_us_median: the median cape time over `capes`), and the characters' motion
 /// before the step (motion_time_us_median, _p95; motion_share_median: the median over frames of motion
-/// time / (motion time + frame time)).
+/// time / (motion time + frame time)), and the metrics measured after the step (metrics_time_us_median,
+/// _p95).
 nlohmann::json frameShareFigures(const FrameTimings& timings, int capes);
 
 /// Which demo's files an output folder holds.

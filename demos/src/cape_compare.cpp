@@ -359,7 +359,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  std::vector<SelfIntersectionCounter> counters(static_cast<std::size_t>(ours->characterCount()));
+  std::vector<FrameMeter> meters(static_cast<std::size_t>(ours->characterCount()));
   Progress progress("cape_compare " + scene, static_cast<long>(frames));
   for (std::int64_t f = 1; f <= frames; ++f) {
     const double t = f / 60.0;
@@ -368,8 +368,8 @@ int main(int argc, char** argv) {
     FrameRow a{f, t, ours->lastFrameTimeUs(), ours->lastCapeTimeUs(), {}};
     // A crowd's row holds the worst of its characters.
     for (int k = 0; k < ours->characterCount(); ++k) {
-      const FrameMetrics m = measureFrame(ours->cape(k), ours->bodyColliders(k), ours->torsoCentre(k),
-                                          &counters[static_cast<std::size_t>(k)]);
+      const FrameMetrics m = meters[static_cast<std::size_t>(k)].measure(
+          ours->cape(k), ours->bodyColliders(k), ours->torsoCentre(k));
       a.metrics = k == 0 ? m : worstOf(a.metrics, m);
     }
     results[0].add(a);

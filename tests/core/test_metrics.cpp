@@ -10,6 +10,7 @@
 #include "cape/scenes/Scene.h"
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <random>
 #include <string>
@@ -173,6 +174,121 @@ TEST(Metrics, OneMeasureFrameForEverySolver) {
   EXPECT_TRUE(blown.blowUp);
   EXPECT_EQ(blown.maxStrain, 0.0f);
   EXPECT_EQ(blown.meanSpeed, 0.0f);
+}
+
+/// Every figure of two frames' metrics, to the bit.
+void expectSameMetrics(const FrameMetrics& a, const FrameMetrics& b, const std::string& where) {
+  EXPECT_EQ(a.maxStrain, b.maxStrain) << where;
+  EXPECT_EQ(a.meanStrain, b.meanStrain) << where;
+  EXPECT_EQ(a.maxPenetration, b.maxPenetration) << where;
+  EXPECT_EQ(a.selfIntersections, b.selfIntersections) << where;
+  EXPECT_EQ(a.pinError, b.pinError) << where;
+  EXPECT_EQ(a.meanSpeed, b.meanSpeed) << where;
+  EXPECT_EQ(a.guardRestored, b.guardRestored) << where;
+  EXPECT_EQ(a.blowUp, b.blowUp) << where;
+  EXPECT_EQ(a.meanDihedral, b.meanDihedral) << where;
+  EXPECT_EQ(a.dihedralChange, b.dihedralChange) << where;
+}
+
+// The meter against measuring every frame afresh (measureFrame and a FoldMeter), over a hang that falls
+// asleep: the same figures every frame, the sleeping frames reused, and any change to an input measured.
+TEST(FrameMeter, ReusesAFrameOnlyWhenItsInputsAreTheSameBits) {
+  SimpleScene scene(SceneKind::Hang, 20, PinLayout::Corners, CapeSettings());
+  ASSERT_TRUE(scene.status().ok());
+  FrameMeter meter(true);
+  FoldMeter folds;
+  std::int64_t asleepFrames = 0;
+  for (int frame = 1; frame <= 900; ++frame) {
+    scene.advanceFrame();
+    const Cape& cape = scene.cape();
+    SelfIntersectionCounter counter;
+    FrameMetrics fresh =
+        measureFrame(cape, scene.body().bodyColliders(), scene.body().torsoCentre(), &counter);
+    const FoldStats fold = folds.measure(cape.fabric(), cape.state().positions);
+    fresh.meanDihedral = fold.meanDihedral;
+    fresh.dihedralChange = fold.meanChange;
+    const FrameMetrics m = meter.measure(cape, scene.body().bodyColliders(), scene.body().torsoCentre());
+    expectSameMetrics(m, fresh, "frame " + std::to_string(frame));
+    // Only a frame the cape slept through (its state untouched) can be reused here.
+    if (meter.lastReused()) {
+      EXPECT_TRUE(cape.isAsleep()) << frame;
+    }
+    asleepFrames += cape.isAsleep() ? 1 : 0;
+  }
+  ASSERT_TRUE(scene.cape().isAsleep());
+  // Every frame after the first it slept through (the frame it fell asleep in changed its state).
+  EXPECT_GE(meter.reusedFrames(), asleepFrames - 1);
+  EXPECT_GT(meter.reusedFrames(), 100);
+
+  // The same inputs in other arrays: reused. One bit changed anywhere: measured.
+  const Cape& cape = scene.cape();
+  const CapeState& st = cape.state();
+  std::vector<Collider> body(scene.body().bodyColliders().begin(), scene.body().bodyColliders().end());
+  const Vec3 centre = scene.body().torsoCentre();
+  Points x = st.positions, v = st.velocities;
+  std::vector<Pin> pins = st.pins;
+  const FrameMetrics rest = meter.measure(cape.fabric(), x, v, pins, body, centre);
+  EXPECT_TRUE(meter.lastReused());
+  const auto measuredAfter = [&](const char* what, const std::function<void()>& change,
+                                 const std::function<void()>& undo) {
+    change();
+    SelfIntersectionCounter counter;
+    FrameMetrics fresh = measureFrame(cape.fabric(), x, v, pins, body, centre, &counter);
+    const FrameMetrics m = meter.measure(cape.fabric(), x, v, pins, body, centre);
+    EXPECT_FALSE(meter.lastReused()) << what;
+    EXPECT_EQ(m.maxPenetration, fresh.maxPenetration) << what;
+    EXPECT_EQ(m.meanSpeed, fresh.meanSpeed) << what;
+    EXPECT_EQ(m.pinError, fresh.pinError) << what;
+    undo();
+    meter.measure(cape.fabric(), x, v, pins, body, centre);
+    const FrameMetrics back = meter.measure(cape.fabric(), x, v, pins, body, centre);
+    EXPECT_TRUE(meter.lastReused()) << what;
+    EXPECT_EQ(back.maxStrain, rest.maxStrain) << what;
+  };
+  const auto nudge = [](float& f) { f = std::nextafter(f, 1e30f); };
+  const auto unnudge = [](float& f) { f = std::nextafter(f, -1e30f); };
+  measuredAfter(
+      "a position", [&] { nudge(x(7, 1)); }, [&] { unnudge(x(7, 1)); });
+  measuredAfter(
+      "a velocity", [&] { v(3, 0) = 1.0f; }, [&] { v(3, 0) = st.velocities(3, 0); });
+  measuredAfter(
+      "a pin's target", [&] { nudge(pins[0].target.x()); }, [&] { unnudge(pins[0].target.x()); });
+  // A collider moved into the cape by a centimetre: the penetration must be measured again.
+  const Vec3 at = body[0].current.position;
+  measuredAfter(
+      "a collider's pose", [&] { body[0].current.position = Vec3(x.row(200).transpose()); },
+      [&] { body[0].current.position = at; });
+  measuredAfter(
+      "a collider's size", [&] { nudge(body[0].radius); }, [&] { unnudge(body[0].radius); });
+  measuredAfter(
+      "a collider more", [&] { body.push_back(Collider::sphere(0.1f)); }, [&] { body.pop_back(); });
+  // What the numerical guard restored is a blow-up, measured: and the frame after it is measured too.
+  const FrameMetrics guarded = meter.measure(cape.fabric(), x, v, pins, body, centre, 3);
+  EXPECT_FALSE(meter.lastReused());
+  EXPECT_TRUE(guarded.blowUp);
+  EXPECT_EQ(guarded.guardRestored, 3u);
+  const FrameMetrics after = meter.measure(cape.fabric(), x, v, pins, body, centre);
+  EXPECT_FALSE(meter.lastReused());
+  EXPECT_FALSE(after.blowUp);
+}
+
+// A triangle mesh's triangles are refilled in place between steps: the meter compares them, not the pointer.
+TEST(FrameMeter, ComparesATriangleMeshByItsTriangles) {
+  Cape cape(makeGrid(6, 6), CapeSettings(), Pose{Vec3(-0.3f, 1.5f, 0.0f), Quat::Identity()});
+  auto soup = std::make_shared<TriangleSoup>();
+  soup->corners = {Vec3(-1.0f, 0.0f, -1.0f), Vec3(1.0f, 0.0f, -1.0f), Vec3(0.0f, 0.0f, 1.0f)};
+  const std::vector<Collider> body{Collider::triangleMesh(soup)};
+  FrameMeter meter;
+  const FrameMetrics first = meter.measure(cape, body, Vec3(0.0f, 1.0f, 0.0f));
+  meter.measure(cape, body, Vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_TRUE(meter.lastReused());
+  // The same soup, its triangle raised into the cape: measured again.
+  for (Vec3& c : soup->corners) c.y() = 1.2f;
+  const FrameMetrics raised = meter.measure(cape, body, Vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_FALSE(meter.lastReused());
+  EXPECT_EQ(first.maxPenetration, 0.0f);
+  SelfIntersectionCounter counter;
+  EXPECT_EQ(raised.maxPenetration, measureFrame(cape, body, Vec3(0.0f, 1.0f, 0.0f), &counter).maxPenetration);
 }
 
 TEST(Metrics, WorstOfTwoFrames) {

@@ -137,6 +137,48 @@ CAPE_SCENES_API FrameMetrics measureFrame(const Cape& cape, ColliderSpan bodyCol
                                           const Vec3& torsoCentre,
                                           SelfIntersectionCounter* selfIntersections);
 
+/// Measures one cloth frame after frame as the demos do: measureFrame with a SelfIntersectionCounter of its
+/// own, and (when asked) the fold statistics of a FoldMeter. A frame whose inputs are bit for bit the last
+/// frame's (positions, velocities, pins, the body colliders' shapes and current poses, the blow-up centre)
+/// has the last frame's figures, its fold change 0, which is what measuring it again would give: a cape
+/// asleep among still bodies then costs a comparison of its inputs, not the metrics. One meter per cape
+/// (it keeps a copy of the last inputs; no allocation once it has seen the cape's size and colliders).
+class CAPE_SCENES_API FrameMeter {
+ public:
+  /// `folds`: also measure FrameMetrics::meanDihedral and dihedralChange (FoldMeter).
+  explicit FrameMeter(bool folds = false) : measureFolds_(folds) {}
+  /// The metrics of a frame, as measureFrame with this meter's counter, and the fold statistics when the
+  /// meter measures them and the frame did not blow up. `guardRestored` (Cape::guard() over the frame)
+  /// goes into FrameMetrics::guardRestored and makes the frame a blow-up; such a frame is always measured.
+  FrameMetrics measure(const Fabric& fabric, const Points& positions, const Points& velocities,
+                       const std::vector<Pin>& pins, ColliderSpan bodyColliders, const Vec3& torsoCentre,
+                       std::uint32_t guardRestored = 0);
+  /// Our cape's frame: the function above on its fabric, its state and its pins.
+  FrameMetrics measure(const Cape& cape, ColliderSpan bodyColliders, const Vec3& torsoCentre,
+                       std::uint32_t guardRestored = 0);
+  /// True when the last measure() reused the frame before's figures.
+  bool lastReused() const { return lastReused_; }
+  /// Frames measured so far that reused the frame before's figures.
+  std::int64_t reusedFrames() const { return reused_; }
+
+ private:
+  /// The colliders as the metrics read them (shape, sizes, skin, current pose, hull, triangles), as bits.
+  void colliderKey(ColliderSpan colliders, std::vector<std::uint32_t>& key) const;
+
+  SelfIntersectionCounter counter_;
+  FoldMeter folds_;
+  bool measureFolds_ = false;
+  bool have_ = false;  ///< the members below hold the last measured frame
+  bool lastReused_ = false;
+  std::int64_t reused_ = 0;
+  const Fabric* fabric_ = nullptr;
+  Points positions_, velocities_;
+  std::vector<Pin> pins_;
+  Vec3 centre_ = Vec3::Zero();
+  std::vector<std::uint32_t> key_, nextKey_;
+  FrameMetrics last_;
+};
+
 /// The worst of two frames, metric by metric (the larger strain, penetration, count, pin error and speed;
 /// blown up if either is): a crowd's row holds the worst of its characters.
 CAPE_SCENES_API FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b);
