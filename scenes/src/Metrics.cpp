@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstring>
 #include <limits>
+#include <unordered_map>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -637,42 +638,93 @@ FrameMetrics worstOf(const FrameMetrics& a, const FrameMetrics& b) {
   return m;
 }
 
-FoldStats FoldMeter::measure(const Fabric& fabric, const Points& x) {
+namespace {
+
+/// acos(c) for c in [-1, 1], within 1e-6 rad: Abramowitz and Stegun 4.4.46 (acos x = sqrt(1 - x) times a
+/// polynomial of degree 7 for x in [0, 1], error 2e-8 rad) and acos(-x) = pi - acos(x). Branch-free, so that
+/// a loop of it vectorises (std::acos does not).
+inline float acosOfCosine(float c) {
+  const float x = std::fabs(c);
+  float p = -0.0012624911f;
+  p = p * x + 0.0066700901f;
+  p = p * x - 0.0170881256f;
+  p = p * x + 0.0308918810f;
+  p = p * x - 0.0501743046f;
+  p = p * x + 0.0889789874f;
+  p = p * x - 0.2145988016f;
+  p = p * x + 1.5707963050f;
+  const float a = std::sqrt(std::max(0.0f, 1.0f - x)) * p;
+  return c < 0.0f ? 3.14159265358979f - a : a;
+}
+
+}  // namespace
+
+void FoldMeter::findEdges(const Fabric& fabric) {
+  // Each interior edge once, from the triangle that runs along it from the lower index; the triangle
+  // across it runs along it the other way (both counter-clockwise) and has the edge's far corner.
   const std::vector<TriangleLocalSet>& local = fabric.triangleLocal();
-  const float none = std::numeric_limits<float>::quiet_NaN();
-  if (last_.size() != 3 * local.size()) last_.assign(3 * local.size(), none);
-  FoldStats f;
-  if (static_cast<std::size_t>(x.rows()) != fabric.particleCount()) return f;
-  const auto point = [&](std::uint32_t i) { return Vec3(x.row(i).transpose()); };
-  double sum = 0.0, change = 0.0;
-  std::size_t changed = 0;
+  std::unordered_map<std::uint64_t, std::uint32_t> byEdge;  // directed edge (a, b) -> its triangle
+  byEdge.reserve(3 * local.size());
+  const auto key = [](std::uint32_t a, std::uint32_t b) { return (std::uint64_t{a} << 32) | b; };
+  for (std::size_t t = 0; t < local.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k)
+      byEdge.emplace(key(local[t].v[k], local[t].v[(k + 1) % 3]), static_cast<std::uint32_t>(t));
+  edges_[0].clear();
+  edges_[1].clear();
   for (std::size_t t = 0; t < local.size(); ++t) {
     const std::uint32_t* v = local[t].v;
-    const Vec3 a = point(v[0]), b = point(v[1]), c = point(v[2]);
-    const Vec3 n = (b - a).cross(c - a);
     for (std::size_t k = 0; k < 3; ++k) {
-      float& last = last_[3 * t + k];
-      const std::uint32_t far = v[3 + k];
-      // Each interior edge once: from the triangle that runs along it from the lower index.
-      if (far == ~0u || v[k] > v[(k + 1) % 3]) continue;
-      // Edge k runs from corner k to corner k + 1; across it, the other triangle is (k + 1, k, far),
-      // counter-clockwise like this one.
-      const Vec3 p = point(v[k]), q = point(v[(k + 1) % 3]), r = point(far);
-      const Vec3 m = (p - q).cross(r - q);
-      const float nn = n.norm(), mm = m.norm();
-      if (!(nn > 1e-12f) || !(mm > 1e-12f) || !std::isfinite(nn) || !std::isfinite(mm)) {
-        last = none;
-        continue;
-      }
-      const float angle = std::acos(std::clamp(n.dot(m) / (nn * mm), -1.0f, 1.0f));
-      sum += static_cast<double>(angle);
-      ++f.edges;
-      if (!std::isnan(last)) {
-        change += static_cast<double>(std::fabs(angle - last));
-        ++changed;
-      }
-      last = angle;
+      const std::uint32_t a = v[k], b = v[(k + 1) % 3], far = v[3 + k];
+      if (far == ~0u || a > b) continue;
+      const auto across = byEdge.find(key(b, a));
+      if (across == byEdge.end()) continue;
+      const std::uint32_t* w = local[across->second].v;
+      if (w[0] != far && w[1] != far && w[2] != far) continue;
+      edges_[0].push_back(static_cast<std::uint32_t>(t));
+      edges_[1].push_back(across->second);
     }
+  }
+  for (std::vector<float>& n : normal_) n.assign(local.size(), 0.0f);
+  last_.assign(edges_[0].size(), std::numeric_limits<float>::quiet_NaN());
+  fabric_ = &fabric;
+}
+
+FoldStats FoldMeter::measure(const Fabric& fabric, const Points& x) {
+  if (fabric_ != &fabric || normal_[0].size() != fabric.triangleLocal().size()) findEdges(fabric);
+  FoldStats f;
+  if (static_cast<std::size_t>(x.rows()) != fabric.particleCount()) return f;
+  // Every triangle's unit normal once (0 for a degenerate or non-finite one: such edges are left out).
+  const std::vector<TriangleLocalSet>& local = fabric.triangleLocal();
+  for (std::size_t t = 0; t < local.size(); ++t) {
+    const std::uint32_t* v = local[t].v;
+    const Vec3 a = x.row(v[0]), b = x.row(v[1]), c = x.row(v[2]);
+    const Vec3 n = (b - a).cross(c - a);
+    const float length = n.norm();
+    const bool ok = length > 1e-12f && std::isfinite(length);
+    for (int k = 0; k < 3; ++k) normal_[k][t] = ok ? n[k] / length : 0.0f;
+  }
+  double sum = 0.0, change = 0.0;
+  std::size_t changed = 0;
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t e = 0; e < edges_[0].size(); ++e) {
+    const std::uint32_t s = edges_[0][e], t = edges_[1][e];
+    const float c =
+        normal_[0][s] * normal_[0][t] + normal_[1][s] * normal_[1][t] + normal_[2][s] * normal_[2][t];
+    float& last = last_[e];
+    const bool ok = (normal_[0][s] != 0.0f || normal_[1][s] != 0.0f || normal_[2][s] != 0.0f) &&
+                    (normal_[0][t] != 0.0f || normal_[1][t] != 0.0f || normal_[2][t] != 0.0f);
+    if (!ok) {
+      last = none;
+      continue;
+    }
+    const float angle = acosOfCosine(std::clamp(c, -1.0f, 1.0f));
+    sum += static_cast<double>(angle);
+    ++f.edges;
+    if (!std::isnan(last)) {
+      change += static_cast<double>(std::fabs(angle - last));
+      ++changed;
+    }
+    last = angle;
   }
   if (f.edges > 0) f.meanDihedral = static_cast<float>(sum / static_cast<double>(f.edges));
   if (changed > 0) f.meanChange = static_cast<float>(change / static_cast<double>(changed));

@@ -191,12 +191,41 @@ void BM_MeasureFrameNew(benchmark::State& state) {
   report(state, scene, m.selfIntersections);
 }
 
+// The fold statistics (FoldMeter: every interior edge's dihedral angle and its change), which cape_walk
+// measures on its first cape every frame.
+void BM_FoldMeter(benchmark::State& state) {
+  const SimpleScene& scene = sceneFor(static_cast<int>(state.range(0)));
+  FoldMeter folds;
+  FoldStats f;
+  for (auto _ : state) {
+    f = folds.measure(scene.cape().fabric(), scene.cape().state().positions);
+    benchmark::DoNotOptimize(f);
+  }
+  report(state, scene, static_cast<double>(f.meanDihedral));
+}
+
+// FrameMeter on a frame whose inputs are the last one's (a cape asleep among still bodies): the comparison
+// that replaces measuring it.
+void BM_FrameMeterReused(benchmark::State& state) {
+  const SimpleScene& scene = sceneFor(static_cast<int>(state.range(0)));
+  FrameMeter meter(true);
+  FrameMetrics m = meter.measure(scene.cape(), scene.body().bodyColliders(), scene.body().torsoCentre());
+  for (auto _ : state) {
+    m = meter.measure(scene.cape(), scene.body().bodyColliders(), scene.body().torsoCentre());
+    benchmark::DoNotOptimize(m);
+  }
+  if (!meter.lastReused()) state.SkipWithError("the frame was measured again");
+  report(state, scene, m.maxStrain);
+}
+
 BENCHMARK(BM_CountOld)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_CountNew)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PenetrationOld)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PenetrationNew)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_MeasureFrameOld)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_MeasureFrameNew)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FoldMeter)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FrameMeterReused)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -119,7 +119,13 @@ class CAPE_SCENES_API FoldMeter {
   FoldStats measure(const Fabric& fabric, const Points& positions);
 
  private:
-  std::vector<float> last_;  ///< per triangle edge slot (3 t + k): the last angle, NaN if not measured
+  /// The interior edges of `fabric` as pairs of triangles (once per fabric).
+  void findEdges(const Fabric& fabric);
+
+  const Fabric* fabric_ = nullptr;       ///< the fabric edges_ were found on
+  std::vector<std::uint32_t> edges_[2];  ///< per interior edge: its two triangles
+  std::vector<float> normal_[3];         ///< per triangle: its unit normal, 0 if degenerate or not finite
+  std::vector<float> last_;              ///< per interior edge: the last angle, NaN if not measured
 };
 
 /// Measures a frame of any solver's cloth on `fabric` (ours, or a Bullet twin copied into these arrays), so
