@@ -543,43 +543,11 @@ bool sameBits(const Points& a, const Points& b) {
          (a.size() == 0 || std::memcmp(a.data(), b.data(), sizeof(float) * std::size_t(a.size())) == 0);
 }
 
-void appendBits(std::vector<std::uint32_t>& key, const float* values, std::size_t count) {
-  const std::size_t at = key.size();
-  key.resize(at + count);
-  if (count > 0) std::memcpy(key.data() + at, values, sizeof(float) * count);
-}
-
 }  // namespace
-
-void FrameMeter::colliderKey(ColliderSpan colliders, std::vector<std::uint32_t>& key) const {
-  key.clear();
-  for (const Collider& c : colliders) {
-    key.push_back(static_cast<std::uint32_t>(c.shape));
-    key.push_back(static_cast<std::uint32_t>(c.axis));
-    const float sizes[] = {c.radius, c.halfHeight, c.constant, c.thickness};
-    appendBits(key, sizes, 4);
-    appendBits(key, c.halfExtents.data(), 3);
-    appendBits(key, c.normal.data(), 3);
-    for (const Pose* pose : {&c.previous, &c.current}) {
-      appendBits(key, pose->position.data(), 3);
-      appendBits(key, pose->rotation.coeffs().data(), 4);
-    }
-    // A hull is immutable (shared const): its address names it. A soup is refilled between steps: its
-    // triangles themselves.
-    const auto hull = reinterpret_cast<std::uintptr_t>(c.hull.get());
-    key.push_back(static_cast<std::uint32_t>(hull));
-    key.push_back(static_cast<std::uint32_t>(static_cast<std::uint64_t>(hull) >> 32));
-    const std::size_t corners = c.triangles ? c.triangles->corners.size() : 0;
-    key.push_back(c.triangles ? 1u : 0u);
-    key.push_back(static_cast<std::uint32_t>(corners));
-    for (std::size_t k = 0; k < corners; ++k) appendBits(key, c.triangles->corners[k].data(), 3);
-  }
-}
 
 FrameMetrics FrameMeter::measure(const Fabric& fabric, const Points& x, const Points& v,
                                  const std::vector<Pin>& pins, ColliderSpan bodyColliders,
                                  const Vec3& torsoCentre, std::uint32_t guardRestored) {
-  colliderKey(bodyColliders, nextKey_);
   const auto samePins = [&]() {
     if (pins.size() != pins_.size()) return false;
     for (std::size_t k = 0; k < pins.size(); ++k)
@@ -590,7 +558,8 @@ FrameMetrics FrameMeter::measure(const Fabric& fabric, const Points& x, const Po
   };
   lastReused_ = have_ && guardRestored == 0 && last_.guardRestored == 0 && &fabric == fabric_ &&
                 std::memcmp(torsoCentre.data(), centre_.data(), sizeof(float) * 3) == 0 &&
-                sameBits(x, positions_) && sameBits(v, velocities_) && samePins() && nextKey_ == key_;
+                sameBits(x, positions_) && sameBits(v, velocities_) && samePins() &&
+                colliders_.same(bodyColliders);
   if (lastReused_) {
     ++reused_;
     last_.dihedralChange = 0.0f;  // every angle as it was
@@ -611,7 +580,7 @@ FrameMetrics FrameMeter::measure(const Fabric& fabric, const Points& x, const Po
   velocities_ = v;
   pins_ = pins;
   centre_ = torsoCentre;
-  key_.swap(nextKey_);
+  colliders_.remember(bodyColliders);
   last_ = m;
   return m;
 }

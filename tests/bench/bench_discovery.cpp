@@ -79,6 +79,44 @@ void BM_DiscoveryWalkFrame(benchmark::State& state) {
   if (!action.positions().allFinite()) state.SkipWithError("the cape blew up");
 }
 
+// Sleeping in a Bullet world (CapeSettings::sleepSpeed): the same character standing still on the ground
+// (its kinematic bodies never moved), its cape settled for 20 s, then one frame, asleep (sleep:1, the
+// default) against never sleeping (sleep:0). Reported as above: cape_us, cape_us_p50 (the action's own time
+// per frame: its four prepares, which check the world, and the core's steps), and asleep.
+void BM_ActionHangSettled(benchmark::State& state) {
+  World w;
+  cape::bullet::CapeActionSettings settings;
+  SimpleWalk hang(w, btVector3(0, 0, 0), settings, true);
+  cape::bullet::CapeAction& action = *hang.action;
+  if (state.range(0) == 0) {
+    cape::CapeSettings s = action.cape().settings();
+    s.sleepSpeed = 0.0f;
+    if (!action.cape().setSettings(s).ok()) {
+      state.SkipWithError("settings refused");
+      return;
+    }
+  }
+  const auto frame = [&]() { w.world->stepSimulation(kFrame, 8, kFixed); };
+  for (int k = 0; k < 1200; ++k) frame();
+  action.takeAccumulatedMicroseconds();
+  std::vector<double> perFrame;
+  perFrame.reserve(1 << 16);
+  double capeMicroseconds = 0.0;
+  for (auto _ : state) {
+    frame();
+    const double t = action.takeAccumulatedMicroseconds();
+    capeMicroseconds += t;
+    perFrame.push_back(t);
+  }
+  if (!perFrame.empty()) {
+    std::nth_element(perFrame.begin(), perFrame.begin() + perFrame.size() / 2, perFrame.end());
+    state.counters["cape_us_p50"] = perFrame[perFrame.size() / 2];
+  }
+  state.counters["cape_us"] = benchmark::Counter(capeMicroseconds, benchmark::Counter::kAvgIterations);
+  state.counters["asleep"] = action.cape().isAsleep() ? 1.0 : 0.0;
+  if (!action.positions().allFinite()) state.SkipWithError("the cape blew up");
+}
+
 }  // namespace
 
 BENCHMARK(BM_DiscoveryWalkFrame)
@@ -88,3 +126,4 @@ BENCHMARK(BM_DiscoveryWalkFrame)
     ->Args({10, 10000})
     ->Args({10000, 10})
     ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ActionHangSettled)->ArgName("sleep")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);

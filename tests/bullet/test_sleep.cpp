@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 
 namespace {
@@ -69,6 +70,34 @@ TEST(BulletSleep, ABodyComingNearWakesIt) {
     woke = !scene.action->cape().isAsleep();
   }
   EXPECT_TRUE(woke);
+}
+
+// A body the cape found (not one it is pinned to) leaving the world while the cape sleeps: the broadphase's
+// report changes, the action builds its colliders afresh without it, and the cape wakes and swings free of
+// where it was.
+TEST(BulletSleep, ABodyItRestsOnLeavingTheWorldWakesIt) {
+  World w;
+  SimpleWalk scene(w);
+  still(w, 600);
+  const CapeAction& a = *scene.action;
+  ASSERT_TRUE(a.cape().isAsleep());
+  btRigidBody* torso = scene.parts[0].first;
+  const auto follows = [&] {
+    return std::find(a.activeObjects().begin(), a.activeObjects().end(), torso) != a.activeObjects().end();
+  };
+  ASSERT_TRUE(follows());
+  // Asleep, a frame changes nothing: the same objects, the same positions.
+  const cape::Points x = a.cape().state().positions;
+  still(w, 1);
+  EXPECT_TRUE(a.cape().isAsleep());
+  EXPECT_TRUE(follows());
+  EXPECT_TRUE(sameBits(x, a.cape().state().positions));
+  w.world->removeRigidBody(torso);
+  still(w, 1);
+  EXPECT_FALSE(follows());
+  EXPECT_FALSE(a.cape().isAsleep());
+  still(w, 30);
+  EXPECT_FALSE(sameBits(x, a.cape().state().positions)) << "it fell where the torso was";
 }
 
 TEST(BulletSleep, AChangeOfItsCollidersWakesIt) {

@@ -3,12 +3,15 @@
 #include "HangingCape.h"
 
 #include "cape/core/Cape.h"
+#include "cape/core/ColliderRecord.h"
 #include "cape/scenes/Scene.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -198,6 +201,81 @@ TEST(Sleep, SettingsAreChecked) {
   EXPECT_FALSE(s.validate().ok());
   s.sleepDelay = 0.0f;
   EXPECT_TRUE(s.validate().ok());
+}
+
+// stepAsleep, for a caller that vouches for its colliders: the same clock, state and count as step() with
+// the colliders of the last step, and a refusal whenever step() would simulate.
+TEST(Sleep, StepAsleepIsTheSleepingStepWithoutTheComparison) {
+  Hanging vouched{CapeSettings()}, compared{CapeSettings()};
+  vouched.frames(600);
+  compared.frames(600);
+  ASSERT_TRUE(vouched.cape.isAsleep());
+  for (int k = 0; k < 50; ++k) {
+    EXPECT_TRUE(vouched.cape.stepAsleep(1.0f / 240.0f));
+    compared.cape.step(1.0f / 240.0f, compared.colliders);
+  }
+  EXPECT_EQ(vouched.cape.sleptSteps(), compared.cape.sleptSteps());
+  EXPECT_EQ(vouched.cape.state().time, compared.cape.state().time);
+  EXPECT_TRUE(sameBits(vouched.cape.state().positions, compared.cape.state().positions));
+  EXPECT_TRUE(sameBits(vouched.cape.state().velocities, compared.cape.state().velocities));
+  // Not a step's dt: refused, nothing counted.
+  const std::uint64_t slept = vouched.cape.sleptSteps();
+  for (float dt : {0.0f, -1.0f, std::numeric_limits<float>::quiet_NaN()})
+    EXPECT_FALSE(vouched.cape.stepAsleep(dt));
+  EXPECT_EQ(vouched.cape.sleptSteps(), slept);
+  // A pin moved: refused (it wakes the cape; step() simulates it).
+  vouched.movePins(Vec3(0.0f, 0.01f, 0.0f));
+  EXPECT_FALSE(vouched.cape.stepAsleep(1.0f / 240.0f));
+  EXPECT_EQ(vouched.cape.sleptSteps(), slept);
+  // Awake: refused.
+  Hanging awake{neverSleeps()};
+  awake.frames(60);
+  EXPECT_FALSE(awake.cape.stepAsleep(1.0f / 240.0f));
+  // On its coarse level: refused (the coarse level sleeps in step()).
+  Hanging coarse{CapeSettings()};
+  ASSERT_TRUE(coarse.cape.setCoarseLevel(true).ok());
+  coarse.frames(900);
+  EXPECT_FALSE(coarse.cape.stepAsleep(1.0f / 240.0f));
+}
+
+// The record a sleeping cape and the demos' metrics compare colliders with: every field the cape or the
+// metrics read, bit for bit; a triangle soup by its corners (refilled in place), a hull by its address.
+TEST(ColliderRecord, SeesEveryBitThatMattersAndNothingElse) {
+  auto soup = std::make_shared<TriangleSoup>();
+  soup->corners = {Vec3(0.0f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), Vec3(0.0f, 0.0f, 1.0f)};
+  std::vector<Collider> colliders{Collider::sphere(0.1f), Collider::capsule(0.05f, 0.2f, 1),
+                                  Collider::triangleMesh(soup), Collider::plane(Vec3::UnitY(), 0.0f)};
+  ColliderRecord record;
+  record.remember(colliders);
+  EXPECT_TRUE(record.same(colliders));
+  const std::vector<Collider> copy = colliders;
+  EXPECT_TRUE(record.same(copy));
+  colliders[0].name = "renamed";  // reports only
+  EXPECT_TRUE(record.same(colliders));
+  const auto changes = [&](const char* what, const std::function<void()>& change) {
+    const std::vector<Collider> before = colliders;
+    const std::vector<Vec3> corners = soup->corners;
+    change();
+    EXPECT_FALSE(record.same(colliders)) << what;
+    colliders = before;
+    soup->corners = corners;
+    EXPECT_TRUE(record.same(colliders)) << what;
+  };
+  const auto ulp = [](float& f) { f = std::nextafter(f, 1e30f); };
+  changes("a radius", [&] { ulp(colliders[0].radius); });
+  changes("a half height", [&] { ulp(colliders[1].halfHeight); });
+  changes("an axis", [&] { colliders[1].axis = 2; });
+  changes("a thickness", [&] { ulp(colliders[0].thickness); });
+  changes("a friction", [&] { colliders[3].friction = 0.5f; });
+  changes("a current pose", [&] { ulp(colliders[1].current.position.z()); });
+  changes("a previous pose", [&] { ulp(colliders[1].previous.rotation.w()); });
+  changes("a plane's constant", [&] { ulp(colliders[3].constant); });
+  changes("a corner of the soup, in place", [&] { ulp(soup->corners[2].x()); });
+  changes("a triangle more", [&] { soup->corners.insert(soup->corners.end(), 3, Vec3::Ones()); });
+  changes("another soup of the same corners",
+          [&] { colliders[2].triangles = std::make_shared<TriangleSoup>(*soup); });
+  changes("a collider less", [&] { colliders.pop_back(); });
+  changes("the order", [&] { std::swap(colliders[0], colliders[1]); });
 }
 
 }  // namespace

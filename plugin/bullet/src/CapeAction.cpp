@@ -414,9 +414,13 @@ void CapeAction::dropMissing(btCollisionWorld* world) {
 }
 
 void CapeAction::discover(btCollisionWorld* world) {
-  for (Tracked& t : tracked_) t.discovered = false;
   discoveryChanged_ = false;
-  if (!settings_.discoverColliders) return;
+  if (!settings_.discoverColliders) {
+    for (Tracked& t : tracked_) t.discovered = false;
+    lastFound_.clear();
+    lastReported_.clear();
+    return;
+  }
   // The cape's bounds at the start of the step, grown by its thickness and the discovery margin, in the
   // world (the frame's origin added in double).
   const btScalar grow = btScalar(cape_.settings().collisionThickness) + discoveryReach();
@@ -432,6 +436,12 @@ void CapeAction::discover(btCollisionWorld* world) {
   found_.clear();
   query.found = &found_;
   world->getBroadphase()->aabbTest(query.lo, query.hi, query);
+  // The same report as the last step's (the trees unchanged, as around a cape at rest) finds the same
+  // objects at the same indices: every followed object's flag and index stand as the last step set them
+  // (an object that left the world since would be missing from the report).
+  if (found_ == lastReported_) return;
+  lastReported_ = found_;  // keeps its capacity
+  for (Tracked& t : tracked_) t.discovered = false;
   // The broadphase reports in its trees' order: the world's array order makes the objects first seen in
   // this step follow (and collide) in the same order whatever the trees look like.
   std::sort(found_.begin(), found_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -757,6 +767,7 @@ btScalar CapeAction::discoveryReach() const {
 
 void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   due_ = false;
+  resting_ = false;
   if (!ok() || world == nullptr || !(dt > 0)) return;
   // At a coarser level of detail the internal steps between the cape's own steps only add up their time.
   skippedTime_ += dt;
@@ -771,9 +782,10 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
   reportGuard();
   dropMissing(world);
   discover(world);
-  if (resting()) {
+  resting_ = resting();
+  if (resting_) {
     // Asleep, and nothing it follows has moved or come or gone: the pins and colliders of the last step
-    // stand (Cape::step confirms it and only advances its clock).
+    // stand, and the cape only counts the step (Cape::stepAsleep).
     prepareMicroseconds_ =
         std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
     return;
@@ -797,7 +809,11 @@ void CapeAction::advance(btScalar) {
   if (!ok() || !due_) return;
   due_ = false;
   const auto start = std::chrono::steady_clock::now();
-  cape_.step(static_cast<float>(stepTime_), ColliderSpan(colliders_));
+  // A resting cape's colliders are those of its last step, bit for bit (every body they come from checked
+  // by resting()), and that step left it asleep among them.
+  if (!resting_ || !cape_.stepAsleep(static_cast<float>(stepTime_)))
+    cape_.step(static_cast<float>(stepTime_), ColliderSpan(colliders_));
+  resting_ = false;
   ++stepCount_;
   lastStepMicroseconds_ =
       prepareMicroseconds_ +

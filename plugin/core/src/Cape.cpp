@@ -514,6 +514,16 @@ void Cape::step(float dt, ColliderSpan colliders) {
   updateSleep(dt, still, colliders);
 }
 
+bool Cape::stepAsleep(float dt) {
+  // As step() with the colliders of the last step: awake, coarse or leaving the coarse level, it simulates.
+  if (!ok() || !asleep_ || coarseOn_ || steppedCoarse_ || !std::isfinite(dt) || !(dt > 0.0f)) return false;
+  for (const Pin& p : state_.pins)
+    if (p.target != p.previousTarget) return false;
+  state_.time += static_cast<double>(std::min(dt, kMaxStep));
+  ++sleptSteps_;
+  return true;
+}
+
 void Cape::wake() {
   asleep_ = false;
   stillTime_ = 0.0f;

@@ -4,7 +4,8 @@
 
 #include "BodyCollision.h"
 #include "SelfCollision.h"
-#include "SleepRecord.h"
+
+#include "cape/core/ColliderRecord.h"
 
 namespace cape::detail {
 
@@ -21,7 +22,7 @@ struct CapeScratch {
   std::vector<std::uint32_t> lost;  ///< The numerical guard's finds in one step (capacity: every particle).
   BodyCollision body;
   SelfCollision self;
-  SleepRecord sleep;  ///< The colliders a sleeping cape fell asleep among.
+  ColliderRecord sleep;  ///< The colliders a sleeping cape fell asleep among.
 };
 
 }  // namespace cape::detail

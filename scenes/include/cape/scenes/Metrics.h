@@ -4,6 +4,7 @@
 #pragma once
 
 #include "cape/core/Cape.h"
+#include "cape/core/ColliderRecord.h"
 #include "cape/scenes/Export.h"
 
 #include <cstdint>
@@ -145,9 +146,9 @@ CAPE_SCENES_API FrameMetrics measureFrame(const Cape& cape, ColliderSpan bodyCol
 
 /// Measures one cloth frame after frame as the demos do: measureFrame with a SelfIntersectionCounter of its
 /// own, and (when asked) the fold statistics of a FoldMeter. A frame whose inputs are bit for bit the last
-/// frame's (positions, velocities, pins, the body colliders' shapes and current poses, the blow-up centre)
-/// has the last frame's figures, its fold change 0, which is what measuring it again would give: a cape
-/// asleep among still bodies then costs a comparison of its inputs, not the metrics. One meter per cape
+/// frame's (positions, velocities, pins, the body colliders as a ColliderRecord sees them, the blow-up
+/// centre) has the last frame's figures, its fold change 0, which is what measuring it again would give: a
+/// cape asleep among still bodies then costs a comparison of its inputs, not the metrics. One meter per cape
 /// (it keeps a copy of the last inputs; no allocation once it has seen the cape's size and colliders).
 class CAPE_SCENES_API FrameMeter {
  public:
@@ -168,9 +169,6 @@ class CAPE_SCENES_API FrameMeter {
   std::int64_t reusedFrames() const { return reused_; }
 
  private:
-  /// The colliders as the metrics read them (shape, sizes, skin, current pose, hull, triangles), as bits.
-  void colliderKey(ColliderSpan colliders, std::vector<std::uint32_t>& key) const;
-
   SelfIntersectionCounter counter_;
   FoldMeter folds_;
   bool measureFolds_ = false;
@@ -181,7 +179,7 @@ class CAPE_SCENES_API FrameMeter {
   Points positions_, velocities_;
   std::vector<Pin> pins_;
   Vec3 centre_ = Vec3::Zero();
-  std::vector<std::uint32_t> key_, nextKey_;
+  ColliderRecord colliders_;
   FrameMetrics last_;
 };
 

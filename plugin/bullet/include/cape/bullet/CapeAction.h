@@ -384,6 +384,8 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   /// Discovery's scratch: (world array index, object) of every object the broadphase reported this step.
   std::vector<std::pair<int, const btCollisionObject*>> found_;
   std::vector<std::pair<int, const btCollisionObject*>> lastFound_;  ///< found_ of the step before
+  /// The broadphase's report of the step before, in its order (before found_ was sorted).
+  std::vector<std::pair<int, const btCollisionObject*>> lastReported_;
   bool discoveryChanged_ = true;
   bool changed_ = true;  ///< Colliders, settings or the reference body changed since the last full prepare.
 
@@ -400,6 +402,7 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   int skippedSteps_ = 0;      ///< Internal steps since the cape last stepped (at a coarser level).
   btScalar skippedTime_ = 0;  ///< Their time, s.
   bool due_ = false;          ///< prepare() planned a step of stepTime_ s.
+  bool resting_ = false;  ///< prepare() found the cape resting (resting()): advance() only counts the step.
   btScalar stepTime_ = 0;
 
   bool teleported_ = false;

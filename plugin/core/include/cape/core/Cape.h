@@ -202,6 +202,11 @@ class CAPE_CORE_API Cape {
   /// CapeSettings::substeps). Non-finite or non-positive dt is ignored; dt > kMaxStep is kMaxStep. After the
   /// step, the numerical guard (guard()) restores every particle it finds lost.
   void step(float dt, ColliderSpan colliders);
+  /// The step of a sleeping cape whose caller knows its colliders to be, bit for bit, those of its last
+  /// step (the Bullet adapter, which has checked every body they come from): the clock advances by dt, as
+  /// step() with those colliders would do, without comparing them. False, and nothing done, when the cape
+  /// is awake, steps a coarse level (Cape::setCoarseLevel) or dt is not a step's: then call step().
+  bool stepAsleep(float dt);
 
   /// What the numerical guard did. After every step it checks every particle: one whose position or
   /// velocity is not finite (or whose speed squared overflows a float), or, in a piece of the fabric a pin
