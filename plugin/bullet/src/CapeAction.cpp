@@ -441,15 +441,17 @@ void CapeAction::discover(btCollisionWorld* world) {
   // (an object that left the world since would be missing from the report).
   if (found_ == lastReported_) return;
   lastReported_ = found_;  // keeps its capacity
-  for (Tracked& t : tracked_) t.discovered = false;
   // The broadphase reports in its trees' order: the world's array order makes the objects first seen in
   // this step follow (and collide) in the same order whatever the trees look like.
   std::sort(found_.begin(), found_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   found_.erase(std::unique(found_.begin(), found_.end(),
                            [](const auto& a, const auto& b) { return a.first == b.first; }),
                found_.end());
-  discoveryChanged_ = found_ != lastFound_;
-  if (discoveryChanged_) lastFound_ = found_;  // keeps its capacity
+  // The same objects at the same indices in another order (the trees rebalanced): as above.
+  if (found_ == lastFound_) return;
+  discoveryChanged_ = true;
+  lastFound_ = found_;  // keeps its capacity
+  for (Tracked& t : tracked_) t.discovered = false;
   for (const auto& [index, object] : found_) {
     Tracked& t = track(object);
     t.discovered = true;
