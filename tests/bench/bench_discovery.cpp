@@ -32,6 +32,28 @@ namespace {
 
 using namespace capetest;
 
+/// The timed frames of a benchmark: `frame()` once per iteration, and the action's own time per frame as
+/// the counters cape_us (mean) and cape_us_p50 (median).
+template <class Frame>
+void timeFrames(benchmark::State& state, cape::bullet::CapeAction& action, Frame frame) {
+  action.takeAccumulatedMicroseconds();
+  std::vector<double> perFrame;
+  perFrame.reserve(1 << 16);
+  double capeMicroseconds = 0.0;
+  for (auto _ : state) {
+    frame();
+    const double t = action.takeAccumulatedMicroseconds();
+    capeMicroseconds += t;
+    perFrame.push_back(t);
+    benchmark::DoNotOptimize(action.positions().data());
+  }
+  if (!perFrame.empty()) {
+    std::nth_element(perFrame.begin(), perFrame.begin() + perFrame.size() / 2, perFrame.end());
+    state.counters["cape_us_p50"] = perFrame[perFrame.size() / 2];
+  }
+  state.counters["cape_us"] = benchmark::Counter(capeMicroseconds, benchmark::Counter::kAvgIterations);
+}
+
 void BM_DiscoveryWalkFrame(benchmark::State& state) {
   const int seen = static_cast<int>(state.range(0));
   const int unseen = static_cast<int>(state.range(1));
@@ -57,22 +79,7 @@ void BM_DiscoveryWalkFrame(benchmark::State& state) {
   const auto advance = [&]() { walk.advance(); };
   // Warm up one simulated second so that the cape is in contact with the body, as in the other benchmarks.
   for (int k = 0; k < 60; ++k) advance();
-  action.takeAccumulatedMicroseconds();
-  std::vector<double> perFrame;
-  perFrame.reserve(1 << 16);
-  double capeMicroseconds = 0.0;
-  for (auto _ : state) {
-    advance();
-    const double t = action.takeAccumulatedMicroseconds();
-    capeMicroseconds += t;
-    perFrame.push_back(t);
-    benchmark::DoNotOptimize(action.positions().data());
-  }
-  if (!perFrame.empty()) {
-    std::nth_element(perFrame.begin(), perFrame.begin() + perFrame.size() / 2, perFrame.end());
-    state.counters["cape_us_p50"] = perFrame[perFrame.size() / 2];
-  }
-  state.counters["cape_us"] = benchmark::Counter(capeMicroseconds, benchmark::Counter::kAvgIterations);
+  timeFrames(state, action, advance);
   state.counters["world_objects"] = static_cast<double>(w.world->getNumCollisionObjects());
   state.counters["unseen_objects"] = static_cast<double>(other.world->getNumCollisionObjects());
   state.counters["colliders"] = static_cast<double>(action.activeObjects().size());
@@ -98,21 +105,7 @@ void BM_ActionHangSettled(benchmark::State& state) {
   }
   const auto frame = [&]() { w.world->stepSimulation(kFrame, 8, kFixed); };
   for (int k = 0; k < 1200; ++k) frame();
-  action.takeAccumulatedMicroseconds();
-  std::vector<double> perFrame;
-  perFrame.reserve(1 << 16);
-  double capeMicroseconds = 0.0;
-  for (auto _ : state) {
-    frame();
-    const double t = action.takeAccumulatedMicroseconds();
-    capeMicroseconds += t;
-    perFrame.push_back(t);
-  }
-  if (!perFrame.empty()) {
-    std::nth_element(perFrame.begin(), perFrame.begin() + perFrame.size() / 2, perFrame.end());
-    state.counters["cape_us_p50"] = perFrame[perFrame.size() / 2];
-  }
-  state.counters["cape_us"] = benchmark::Counter(capeMicroseconds, benchmark::Counter::kAvgIterations);
+  timeFrames(state, action, frame);
   state.counters["asleep"] = action.cape().isAsleep() ? 1.0 : 0.0;
   if (!action.positions().allFinite()) state.SkipWithError("the cape blew up");
 }
