@@ -810,16 +810,20 @@ void CapeAction::prepare(btCollisionWorld* world, btScalar dt) {
 void CapeAction::advance(btScalar) {
   if (!ok() || !due_) return;
   due_ = false;
-  const auto start = std::chrono::steady_clock::now();
   // A resting cape's colliders are those of its last step, bit for bit (every body they come from checked
-  // by resting()), and that step left it asleep among them.
-  if (!resting_ || !cape_.stepAsleep(static_cast<float>(stepTime_)))
-    cape_.step(static_cast<float>(stepTime_), ColliderSpan(colliders_));
+  // by resting()), and that step left it asleep among them: its step only counts itself, a few
+  // nanoseconds, not timed (two reads of the clock would cost more than the step).
+  const bool slept = resting_ && cape_.stepAsleep(static_cast<float>(stepTime_));
   resting_ = false;
+  double microseconds = 0.0;
+  if (!slept) {
+    const auto start = std::chrono::steady_clock::now();
+    cape_.step(static_cast<float>(stepTime_), ColliderSpan(colliders_));
+    microseconds =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  }
   ++stepCount_;
-  lastStepMicroseconds_ =
-      prepareMicroseconds_ +
-      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  lastStepMicroseconds_ = prepareMicroseconds_ + microseconds;
   prepareMicroseconds_ = 0.0;
   accumulatedMicroseconds_ += lastStepMicroseconds_;
 }

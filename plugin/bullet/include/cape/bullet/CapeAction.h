@@ -298,6 +298,8 @@ class CAPE_BULLET_API CapeAction : public btActionInterface {
   /// renderer drawing the bodies from their motion states should draw the cape.
   const CapeMesh& renderMesh(const btCollisionWorld& world, bool twoSided = false) const;
   /// Wall time of the cape's own work in the last internal step (prepare() and advance()), microseconds.
+  /// The advance of a resting cape (asleep, nothing it follows changed) only counts the step and is not
+  /// timed: its time is the prepare's.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
   /// Sum of lastStepMicroseconds() over the internal steps since the last call of this function (a frame's
   /// cape time when called once per stepSimulation).
