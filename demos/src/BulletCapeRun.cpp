@@ -106,6 +106,7 @@ class BulletCapeRun final : public SceneRun {
   }
   std::vector<std::size_t> detailCounts() const override { return group_->detailCounts(); }
   void setParallelPrepare(bool parallel) { group_->setParallelPrepare(parallel); }
+  Status setSpinMicroseconds(double microseconds) { return group_->setSpinMicroseconds(microseconds); }
   Eigen::Vector3d detailViewpoint() const override { return viewpoint_; }
 
   /// The same motion constraints on every character's cape (one fabric: one weight map fits them all).
@@ -176,6 +177,12 @@ std::unique_ptr<SceneRun> makeSceneRun(const RunOptions& options, std::string& e
   for (const std::string& n : scene->notes()) std::printf("cape_walk: %s\n", n.c_str());
   auto run = std::make_unique<BulletCapeRun>(std::move(scene), options.threads);
   run->setParallelPrepare(options.parallelPrepare);
+  if (options.spinMicroseconds >= 0.0) {
+    if (Status s = run->setSpinMicroseconds(options.spinMicroseconds); !s.ok()) {
+      error = "--spin: " + s.message();
+      return nullptr;
+    }
+  }
   if (!run->build(run->settings(), options.scene, error)) return nullptr;
   if (Status s = run->setDetail(options.lodDistances, options.viewpoint, options.lodCoarse); !s.ok()) {
     error = "--lod: " + s.message();

@@ -40,7 +40,8 @@ struct RunOptions {
   double seconds = -1.0;  ///< < 0: the scene's own length
   int characters = 1;     ///< crowd size
   int threads = 1;
-  bool parallelPrepare = false;  ///< the capes' prepare on the pool too (--parallel-prepare)
+  bool parallelPrepare = false;    ///< the capes' prepare on the pool too (--parallel-prepare)
+  double spinMicroseconds = -1.0;  ///< the pool's spin before sleeping, us (--spin; < 0: the group's default)
   CapeSettings settings;
   bool simpleBody = false;
   std::string urdf;                      ///< empty: the shipped humanoid

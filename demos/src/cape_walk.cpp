@@ -10,6 +10,7 @@
 #include "SceneOptions.h"
 #include "SceneRun.h"
 
+#include "cape/bullet/CapeGroup.h"
 #include "cape/core/Simd.h"
 
 #include <CLI/CLI.hpp>
@@ -140,6 +141,13 @@ int main(int argc, char** argv) {
   app.add_flag("--parallel-prepare", parallelPrepare,
                "with --threads above 1, the capes read the world (discovery, poses) on the workers too "
                "(CapeGroup::setParallelPrepare; the same results)");
+  double spin = bullet::CapeGroup::kDefaultSpinMicroseconds;
+  app.add_option("--spin", spin,
+                 "with --threads above 1, how long the threads spin at each internal step's hand-off before "
+                 "they sleep, us (CapeGroup::setSpinMicroseconds; 0 on a machine with fewer free cores than "
+                 "--threads; the same results)")
+      ->transform(strictReal(0.0, 1e6))
+      ->capture_default_str();
   app.add_option("--out", out,
                  "output folder (default: a fresh runs/<scene>-<time> folder under the current one). A "
                  "folder that holds a previous cape_walk run (only metrics.csv, summary.json, picture.png, "
@@ -180,6 +188,7 @@ int main(int argc, char** argv) {
   }
   o.threads = threads;
   o.parallelPrepare = parallelPrepare;
+  o.spinMicroseconds = spin;
   for (std::size_t k = 1; k < lodDistances.size(); ++k) {
     if (!(lodDistances[k] > lodDistances[k - 1])) {
       std::fprintf(stderr, "cape_walk: --lod: the distances must increase (%g is not beyond %g)\n",
@@ -428,6 +437,7 @@ int main(int argc, char** argv) {
   summary["attachment"] = attachment;
   summary["characters"] = run->characterCount();
   summary["threads"] = threads;
+  summary["spin_us"] = spin;
   summary["simd"] = simdLevelName(simdLevel());
   const Fabric& fabric = run->cape(0).fabric();
   summary["grid"] = {{"columns", fabric.gridColumns()},

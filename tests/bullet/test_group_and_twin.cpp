@@ -6,7 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <thread>
 #include <utility>
@@ -16,15 +19,20 @@ using cape::bullet::CapeAction;
 
 namespace {
 
-/// Two capes pinned to two kinematic bodies that walk and turn, over a sphere each, stepped by a group
-/// of `threads`; returns every cape's final positions.
-std::vector<cape::Points> runGroup(int threads, bool parallelPrepare = false) {
+/// `count` capes pinned to as many kinematic bodies that walk and turn, over a sphere each, stepped by a
+/// group of `threads` (its hand-offs spinning `spin` us before they sleep, or as the group has it when
+/// negative); returns every cape's final positions.
+std::vector<cape::Points> runGroup(int threads, bool parallelPrepare = false, double spin = -1.0,
+                                   int count = 2) {
   World w;
   std::vector<std::unique_ptr<CapeAction>> capes;
   std::vector<btRigidBody*> bodies;
   cape::bullet::CapeGroup group(threads);
   group.setParallelPrepare(parallelPrepare);
-  for (int k = 0; k < 2; ++k) {
+  if (spin >= 0.0) {
+    EXPECT_TRUE(group.setSpinMicroseconds(spin).ok());
+  }
+  for (int k = 0; k < count; ++k) {
     const btVector3 at(btScalar(2 * k), btScalar(1.5), 0);
     bodies.push_back(w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)),
                                     btTransform(btQuaternion::getIdentity(), at)));
@@ -40,7 +48,7 @@ std::vector<cape::Points> runGroup(int threads, bool parallelPrepare = false) {
   w.world->addAction(&group);
   for (int frame = 1; frame <= 40; ++frame) {
     const double t = frame / 60.0;
-    for (int k = 0; k < 2; ++k)
+    for (int k = 0; k < count; ++k)
       World::moveKinematic(bodies[std::size_t(k)],
                            btTransform(btQuaternion(btVector3(0, 1, 0), btScalar(0.8 * t * (k + 1))),
                                        btVector3(btScalar(2 * k), btScalar(1.5 + 0.03 * std::sin(12.0 * t)),
@@ -51,6 +59,16 @@ std::vector<cape::Points> runGroup(int threads, bool parallelPrepare = false) {
   std::vector<cape::Points> out;
   for (const auto& c : capes) out.push_back(c->positions());
   return out;
+}
+
+void expectSameBits(const std::vector<cape::Points>& a, const std::vector<cape::Points>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    ASSERT_TRUE(b[k].allFinite()) << "cape " << k;
+    ASSERT_EQ(a[k].size(), b[k].size());
+    EXPECT_EQ(0, std::memcmp(a[k].data(), b[k].data(), sizeof(float) * std::size_t(a[k].size())))
+        << "cape " << k;
+  }
 }
 
 }  // namespace
@@ -80,6 +98,41 @@ TEST(CapeGroup, APreparePutOnThePoolGivesTheSameBits) {
     EXPECT_EQ(0, std::memcmp(serial[k].data(), one[k].data(), sizeof(float) * std::size_t(serial[k].size())))
         << "cape " << k;
   }
+}
+
+TEST(CapeGroup, SpinningOrSleepingHandOffsGiveTheSameBits) {
+  // The workers wait for each step by sleeping at once, by spinning first, and by spinning through whole
+  // frames; with the prepare on the calling thread and on the pool; three threads for five capes (workers
+  // with two capes and with one).
+  const std::vector<cape::Points> one = runGroup(1, false, -1.0, 5);
+  for (const bool parallel : {false, true})
+    for (const double spin : {0.0, cape::bullet::CapeGroup::kDefaultSpinMicroseconds, 1e6}) {
+      SCOPED_TRACE("parallel prepare " + std::to_string(parallel) + ", spin " + std::to_string(spin));
+      expectSameBits(one, runGroup(3, parallel, spin, 5));
+    }
+}
+
+TEST(CapeGroup, MoreThreadsThanCoresFinishWithTheSameBits) {
+  // Eight workers on what may be two cores, each spinning before it sleeps: the steps hand off all the
+  // same (a worker that spins while the one it waits for has no core only loses its spin).
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const int threads = static_cast<int>(std::max(8u, 4 * cores));
+  expectSameBits(runGroup(1, false, -1.0, 9), runGroup(threads, true, -1.0, 9));
+}
+
+TEST(CapeGroup, RefusesASpinThatIsNotATime) {
+  cape::bullet::CapeGroup group(2);
+  EXPECT_EQ(group.spinMicroseconds(), cape::bullet::CapeGroup::kDefaultSpinMicroseconds);
+  for (const double bad : {-1.0, 2e6, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    const cape::Status s = group.setSpinMicroseconds(bad);
+    EXPECT_FALSE(s.ok()) << bad;
+    EXPECT_NE(s.message().find("setSpinMicroseconds"), std::string::npos) << s.message();
+    EXPECT_EQ(group.spinMicroseconds(), cape::bullet::CapeGroup::kDefaultSpinMicroseconds);
+  }
+  EXPECT_TRUE(group.setSpinMicroseconds(0.0).ok());
+  EXPECT_EQ(group.spinMicroseconds(), 0.0);
+  EXPECT_TRUE(group.setSpinMicroseconds(1e6).ok());
+  EXPECT_EQ(group.spinMicroseconds(), 1e6);
 }
 
 TEST(CapeGroup, WarningsOfAParallelPrepareAreSaidOnceOnTheCallingThread) {

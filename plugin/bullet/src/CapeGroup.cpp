@@ -5,6 +5,10 @@
 #include <cmath>
 #include <string>
 
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>
+#endif
+
 namespace cape::bullet {
 
 CapeGroup::CapeGroup(int threadCount) : threadCount_(std::max(1, threadCount)) {
@@ -12,10 +16,23 @@ CapeGroup::CapeGroup(int threadCount) : threadCount_(std::max(1, threadCount)) {
   for (int w = 1; w < threadCount_; ++w) threads_.emplace_back([this, w] { runWorker(w); });
 }
 
+namespace {
+
+/// A hint to the core that this thread spins (lets its hyperthread sibling run, saves power).
+inline void pause() {
+#if defined(__SSE2__) || defined(_M_X64)
+  _mm_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
+
+}  // namespace
+
 CapeGroup::~CapeGroup() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
+    stopping_.store(true, std::memory_order_release);
   }
   start_.notify_all();
   for (std::thread& t : threads_) t.join();
@@ -43,21 +60,51 @@ void CapeGroup::work(int worker) {
   }
 }
 
+template <class Ready>
+bool CapeGroup::spinUntil(Ready ready) const {
+  // The clock is read every 64 checks: a check is a load, the clock tens of nanoseconds.
+  const double limit = spinMicroseconds_.load(std::memory_order_relaxed);
+  if (!(limit > 0.0)) return ready();
+  const auto start = std::chrono::steady_clock::now();
+  for (;;) {
+    for (int k = 0; k < 64; ++k) {
+      if (ready()) return true;
+      pause();
+    }
+    if (std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() > limit)
+      return ready();
+  }
+}
+
 void CapeGroup::runWorker(int worker) {
   std::uint64_t seen = 0;
+  const auto due = [&] {
+    return stopping_.load(std::memory_order_acquire) || generation_.load(std::memory_order_acquire) != seen;
+  };
   for (;;) {
-    {
+    // Spin for the next step first; then sleep. The generation changes under the mutex and the sleep checks
+    // it under the mutex, so a step begun between the spin and the sleep is not missed.
+    if (!spinUntil(due)) {
       std::unique_lock<std::mutex> lock(mutex_);
-      start_.wait(lock, [&] { return stopping_ || generation_ != seen; });
-      if (stopping_) return;
-      seen = generation_;
+      start_.wait(lock, due);
     }
+    if (stopping_.load(std::memory_order_acquire)) return;
+    seen = generation_.load(std::memory_order_acquire);
     work(worker);
-    {
+    // The last worker to finish wakes the calling thread if it sleeps (notified under the mutex, which the
+    // calling thread holds from its check of pending_ until it sleeps: no lost wake-up).
+    if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (--pending_ == 0) done_.notify_one();
+      done_.notify_one();
     }
   }
+}
+
+Status CapeGroup::setSpinMicroseconds(double microseconds) {
+  if (!std::isfinite(microseconds) || microseconds < 0.0 || microseconds > 1e6)
+    return Status::error("CapeGroup::setSpinMicroseconds: the spin must be finite, in [0, 1e6] us");
+  spinMicroseconds_.store(microseconds, std::memory_order_relaxed);
+  return Status::success();
 }
 
 Status CapeGroup::setDetailPolicy(const btVector3& viewpoint, std::vector<DetailBand> bands,
@@ -132,16 +179,17 @@ void CapeGroup::updateAction(btCollisionWorld* world, btScalar dt) {
     for (CapeAction* cape : capes_) cape->advance(dt);
   } else {
     for (CapeAction* cape : capes_) cape->deferWarnings_ = parallel;
+    pending_.store(static_cast<int>(threads_.size()), std::memory_order_relaxed);
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      pending_ = static_cast<int>(threads_.size());
-      ++generation_;
+      generation_.fetch_add(1, std::memory_order_release);  // publishes pending_ and the step's inputs
     }
     start_.notify_all();
     work(0);
-    {
+    const auto finished = [&] { return pending_.load(std::memory_order_acquire) == 0; };
+    if (!spinUntil(finished)) {
       std::unique_lock<std::mutex> lock(mutex_);
-      done_.wait(lock, [&] { return pending_ == 0; });
+      done_.wait(lock, finished);
     }
     world_ = nullptr;
     for (CapeAction* cape : capes_) {

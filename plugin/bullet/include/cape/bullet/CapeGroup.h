@@ -3,12 +3,16 @@
 /// (world->addAction(&group)) instead of each cape. Every internal step, the group prepares each cape on the
 /// calling thread (reading the world is not shared out), then advances them on a small persistent pool:
 /// cape i always runs on worker i % threadCount (a fixed static partition). Each cape is independent and its
-/// own computation is sequential, so the results are bitwise identical whatever the thread count.
+/// own computation is sequential, so the results are bitwise identical whatever the thread count. The
+/// hand-offs between the calling thread and the workers (every internal step) spin for a while before they
+/// sleep (setSpinMicroseconds): a wake-up from sleep costs tens of microseconds, as much as a small crowd's
+/// step.
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
 #include "cape/bullet/Export.h"
 
+#include <atomic>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
@@ -80,6 +84,18 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   /// Whether the capes are prepared on the pool (setParallelPrepare).
   bool parallelPrepare() const { return parallelPrepare_; }
 
+  // --- Hand-offs ---------------------------------------------------------------------------------------
+  /// How long a worker waiting for the next internal step, and the calling thread waiting for the workers to
+  /// finish one, spin (checking a flag, with a pause instruction) before they sleep on a condition variable,
+  /// microseconds; 0: sleep at once. Spinning keeps the hand-offs of one frame's internal steps from paying
+  /// a sleep's wake-up each; it costs a core while it lasts, so a machine with fewer cores than the group's
+  /// threads and other busy threads may want 0. The results are the same bits either way. An error,
+  /// keeping the value in use, for a value not finite or outside [0, 1e6]. Default: kDefaultSpinMicroseconds.
+  Status setSpinMicroseconds(double microseconds);
+  /// The spin before sleeping, microseconds (setSpinMicroseconds).
+  double spinMicroseconds() const { return spinMicroseconds_.load(std::memory_order_relaxed); }
+  static constexpr double kDefaultSpinMicroseconds = 200.0;
+
   /// Wall time of the last parallel advance of all capes (with their prepare under setParallelPrepare),
   /// microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
@@ -87,6 +103,9 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
  private:
   void work(int worker);
   void runWorker(int worker);
+  /// Spins up to spinMicroseconds_ until `ready()`; true if it came true (then no sleep is needed).
+  template <class Ready>
+  bool spinUntil(Ready ready) const;
   void applyDetailPolicy();
 
   std::vector<CapeAction*> capes_;
@@ -95,9 +114,12 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   std::mutex mutex_;
   std::condition_variable start_;
   std::condition_variable done_;
-  std::uint64_t generation_ = 0;  ///< Incremented for every parallel step.
-  int pending_ = 0;               ///< Workers (threads) still busy with the current step.
-  bool stopping_ = false;
+  /// Incremented for every parallel step (written under mutex_, read by spinning workers without it).
+  std::atomic<std::uint64_t> generation_{0};
+  std::atomic<int> pending_{0};        ///< Workers (threads) still busy with the current step.
+  std::atomic<bool> stopping_{false};  ///< Written under mutex_.
+  /// Read by the workers while they wait, so atomic (relaxed: it orders nothing).
+  std::atomic<double> spinMicroseconds_{kDefaultSpinMicroseconds};
   btScalar dt_ = 0;
   btCollisionWorld* world_ = nullptr;  ///< The world of the step in progress (parallel prepare).
   bool parallelPrepare_ = false;
