@@ -143,9 +143,9 @@ int main(int argc, char** argv) {
                "(CapeGroup::setParallelPrepare; the same results)");
   double spin = bullet::CapeGroup::kDefaultSpinMicroseconds;
   app.add_option("--spin", spin,
-                 "with --threads above 1, how long the threads spin at each internal step's hand-off before "
-                 "they sleep, us (CapeGroup::setSpinMicroseconds; 0 on a machine with fewer free cores than "
-                 "--threads; the same results)")
+                 "with --threads above 1, how long the threads may spin at each internal step's hand-off "
+                 "before they sleep, us (CapeGroup::setSpinMicroseconds: faster where the threads have cores "
+                 "of their own, slower where they have not; 0: sleep at once; the same results)")
       ->transform(strictReal(0.0, 1e6))
       ->capture_default_str();
   app.add_option("--out", out,

@@ -14,6 +14,9 @@
 //   bullet_us         Bullet's own share: stepSimulation's wall time less cape_us
 //   frame_us          stepSimulation's wall time
 //   objects           collision objects in the world (5 per character and the ground)
+//
+// BM_CrowdFrameSpin: BM_CrowdFrame on 2 threads with the group's hand-offs spinning up to S us before they
+// sleep (CapeGroup::setSpinMicroseconds; S = 0: sleep at once, the default).
 #include "cape/bullet/CapeAction.h"
 #include "cape/bullet/CapeGroup.h"
 #include "cape/bullet/Convert.h"
@@ -79,8 +82,10 @@ class TimedGroup final : public btActionInterface {
 };
 
 struct Crowd {
-  Crowd(int count, int threads, bool parallelPrepare = false) : group(threads), timed(group) {
+  Crowd(int count, int threads, bool parallelPrepare = false, double spin = 0.0)
+      : group(threads), timed(group) {
     group.setParallelPrepare(parallelPrepare);
+    (void)group.setSpinMicroseconds(spin);
     world.setGravity(btVector3(0, btScalar(-9.8), 0));
     world.addRigidBody(&ground);
     const cape::CapeRig rig = cape::makeCapeRig(20, cape::PinLayout::Corners);
@@ -144,10 +149,11 @@ struct Crowd {
   int frame = 0;
 };
 
-void BM_CrowdFrame(benchmark::State& state) {
+/// BM_CrowdFrame's body, with the group's hand-offs spinning up to `spin` us.
+void crowdFrame(benchmark::State& state, double spin) {
   const int count = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
-  Crowd crowd(count, threads, state.range(2) != 0);
+  Crowd crowd(count, threads, state.range(2) != 0, spin);
   for (int k = 0; k < 60; ++k) crowd.advance();  // a simulated second of warm-up
   std::vector<double> cape, advance, bullet, frame;
   for (auto _ : state) {
@@ -167,6 +173,14 @@ void BM_CrowdFrame(benchmark::State& state) {
   state.counters["frame_us"] = mean(frame);
   state.counters["objects"] = crowd.world.getNumCollisionObjects();
   if (!crowd.finite()) state.SkipWithError("a cape blew up");
+}
+
+void BM_CrowdFrame(benchmark::State& state) {
+  crowdFrame(state, 0.0);
+}
+
+void BM_CrowdFrameSpin(benchmark::State& state) {
+  crowdFrame(state, static_cast<double>(state.range(3)));
 }
 
 /// The same crowd seen from a camera 4 m in front of its middle at eye height, with levels of detail by
@@ -227,4 +241,11 @@ BENCHMARK(BM_CrowdFrameDetail)->Apply([](benchmark::internal::Benchmark* b) {
   b->Iterations(120)->Unit(benchmark::kMillisecond);
 });
 BENCHMARK(BM_CrowdFrame)->Apply([](benchmark::internal::Benchmark* b) { crowdArgs(b, {16, 100, 1000}); });
+BENCHMARK(BM_CrowdFrameSpin)->Apply([](benchmark::internal::Benchmark* b) {
+  b->ArgNames({"K", "T", "P", "S"});
+  for (int k : {16, 100})
+    for (int parallel : {0, 1})
+      for (int spin : {0, 200}) b->Args({k, 2, parallel, spin});
+  b->Iterations(120)->Unit(benchmark::kMillisecond);
+});
 BENCHMARK_MAIN();

@@ -101,23 +101,80 @@ TEST(CapeGroup, APreparePutOnThePoolGivesTheSameBits) {
 }
 
 TEST(CapeGroup, SpinningOrSleepingHandOffsGiveTheSameBits) {
-  // The workers wait for each step by sleeping at once, by spinning first, and by spinning through whole
-  // frames; with the prepare on the calling thread and on the pool; three threads for five capes (workers
-  // with two capes and with one).
+  // The workers wait for each step by sleeping at once, by spinning first (up to 200 us), and by spinning
+  // up to a second; with the prepare on the calling thread and on the pool; three threads for five capes
+  // (workers with two capes and with one).
   const std::vector<cape::Points> one = runGroup(1, false, -1.0, 5);
   for (const bool parallel : {false, true})
-    for (const double spin : {0.0, cape::bullet::CapeGroup::kDefaultSpinMicroseconds, 1e6}) {
+    for (const double spin : {0.0, 200.0, 1e6}) {
       SCOPED_TRACE("parallel prepare " + std::to_string(parallel) + ", spin " + std::to_string(spin));
       expectSameBits(one, runGroup(3, parallel, spin, 5));
     }
 }
 
 TEST(CapeGroup, MoreThreadsThanCoresFinishWithTheSameBits) {
-  // Eight workers on what may be two cores, each spinning before it sleeps: the steps hand off all the
-  // same (a worker that spins while the one it waits for has no core only loses its spin).
+  // Eight workers or more on what may be two cores, each spinning before it sleeps: the steps hand off all
+  // the same (a worker that spins while the one it waits for has no core only loses its spin).
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const int threads = static_cast<int>(std::max(8u, 4 * cores));
-  expectSameBits(runGroup(1, false, -1.0, 9), runGroup(threads, true, -1.0, 9));
+  expectSameBits(runGroup(1, false, -1.0, 9), runGroup(threads, true, 200.0, 9));
+}
+
+namespace {
+
+/// Capes pinned to bodies that walk, stepped by a group of `threads` spinning up to `spin` us, whose
+/// members change between frames: the second cape leaves at frame 10 and comes back at frame 20 with a new
+/// one, the first leaves at frame 30. A worker still taking capes of a step when the next one starts (it
+/// spins through the gap) must take only that step's. Returns every cape's final positions.
+std::vector<cape::Points> runChangingGroup(int threads, double spin) {
+  World w;
+  std::vector<std::unique_ptr<CapeAction>> capes;
+  std::vector<btRigidBody*> bodies;
+  cape::bullet::CapeGroup group(threads);
+  EXPECT_TRUE(group.setSpinMicroseconds(spin).ok());
+  for (int k = 0; k < 4; ++k) {
+    const btVector3 at(btScalar(2 * k), btScalar(1.5), 0);
+    bodies.push_back(w.addKinematic(new btBoxShape(btVector3(0.2f, 0.3f, 0.1f)),
+                                    btTransform(btQuaternion::getIdentity(), at)));
+    capes.push_back(std::make_unique<CapeAction>(
+        cornerFabric(12), cape::CapeSettings(),
+        btTransform(btQuaternion::getIdentity(), at + btVector3(-0.3f, 0.06f, 0.15f))));
+    capes.back()->attach(0, bodies.back(), btVector3(-0.3f, 0.06f, 0.15f));
+    capes.back()->attach(11, bodies.back(), btVector3(0.3f, 0.06f, 0.15f));
+    if (k < 3) group.add(capes.back().get());
+  }
+  w.world->addAction(&group);
+  for (int frame = 1; frame <= 40; ++frame) {
+    if (frame == 10) group.remove(capes[1].get());
+    if (frame == 20) {
+      group.add(capes[3].get());
+      group.add(capes[1].get());
+    }
+    if (frame == 30) group.remove(capes[0].get());
+    const double t = frame / 60.0;
+    for (int k = 0; k < 4; ++k)
+      World::moveKinematic(bodies[std::size_t(k)],
+                           btTransform(btQuaternion(btVector3(0, 1, 0), btScalar(0.5 * t * (k + 1))),
+                                       btVector3(btScalar(2 * k), btScalar(1.5), btScalar(-1.2 * t))));
+    w.world->stepSimulation(kFrame, 8, kFixed);
+  }
+  w.world->removeAction(&group);
+  std::vector<cape::Points> out;
+  for (const auto& c : capes) out.push_back(c->positions());
+  return out;
+}
+
+}  // namespace
+
+TEST(CapeGroup, MembersChangingBetweenStepsKeepTheBits) {
+  const std::vector<cape::Points> one = runChangingGroup(1, 0.0);
+  // Each cape moved while it was a member, and the ones that left stopped where they were.
+  for (const cape::Points& x : one) ASSERT_TRUE(x.allFinite());
+  EXPECT_GT((one[0] - one[2]).cwiseAbs().maxCoeff(), 0.0f);
+  for (const double spin : {0.0, 200.0}) {
+    SCOPED_TRACE("spin " + std::to_string(spin));
+    expectSameBits(one, runChangingGroup(3, spin));
+  }
 }
 
 TEST(CapeGroup, RefusesASpinThatIsNotATime) {

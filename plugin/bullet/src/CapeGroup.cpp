@@ -13,7 +13,7 @@ namespace cape::bullet {
 
 CapeGroup::CapeGroup(int threadCount) : threadCount_(std::max(1, threadCount)) {
   threads_.reserve(static_cast<std::size_t>(threadCount_ - 1));
-  for (int w = 1; w < threadCount_; ++w) threads_.emplace_back([this, w] { runWorker(w); });
+  for (int w = 1; w < threadCount_; ++w) threads_.emplace_back([this] { runWorker(); });
 }
 
 namespace {
@@ -52,51 +52,76 @@ void CapeGroup::remove(CapeAction* cape) {
   capes_.erase(it);
 }
 
-void CapeGroup::work(int worker) {
-  for (std::size_t i = static_cast<std::size_t>(worker); i < capes_.size();
-       i += static_cast<std::size_t>(threadCount_)) {
-    if (world_ != nullptr) capes_[i]->prepare(world_, dt_);  // a parallel prepare
-    capes_[i]->advance(dt_);
-  }
-}
-
-template <class Ready>
-bool CapeGroup::spinUntil(Ready ready) const {
-  // The clock is read every 64 checks: a check is a load, the clock tens of nanoseconds.
-  const double limit = spinMicroseconds_.load(std::memory_order_relaxed);
-  if (!(limit > 0.0)) return ready();
-  const auto start = std::chrono::steady_clock::now();
+void CapeGroup::work() {
+  // Claims the step's capes one at a time until none is left. The claim word holds the step's cape count
+  // (high half) and the next cape (low half), set together at the start of each step: a claim made late,
+  // by a worker still finishing the step before, reads either that step's word (no cape left) or this
+  // step's (a cape of this step, whose inputs the word's release published), never a count of one step
+  // with an index of another.
   for (;;) {
-    for (int k = 0; k < 64; ++k) {
-      if (ready()) return true;
-      pause();
+    const std::uint64_t word = claim_.fetch_add(1, std::memory_order_acq_rel);
+    const std::uint64_t count = word >> 32, i = word & 0xffffffffu;
+    if (i >= count) return;
+    CapeAction* cape = capes_[static_cast<std::size_t>(i)];
+    if (world_ != nullptr) cape->prepare(world_, dt_);  // a parallel prepare
+    cape->advance(dt_);
+    // The last cape finished wakes the calling thread if it sleeps (under the mutex, which the calling
+    // thread holds from its check until it sleeps: no lost wake-up).
+    if (finished_.fetch_add(1, std::memory_order_acq_rel) + 1 == count) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      done_.notify_one();
     }
-    if (std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() > limit)
-      return ready();
   }
 }
 
-void CapeGroup::runWorker(int worker) {
+template <class Ready, class Sleep>
+void CapeGroup::waitUntil(Ready ready, Sleep sleep, double& budget) const {
+  // Spin while the budget lasts (the clock read every 64 checks: a check is a load, the clock tens of
+  // nanoseconds), then sleep. A wait no longer than the setting doubles the next one's budget (up to the
+  // setting) and a longer one halves it, so that where the waits are long, or the thread waited for has no
+  // core of its own (more busy threads than cores: it runs a time slice later), the spin soon stops costing
+  // anything and the thread sleeps at once; a sleeper is woken ahead of a thread that spins or yields.
+  if (ready()) return;
+  const double limit = spinMicroseconds_.load(std::memory_order_relaxed);
+  if (!(limit > 0.0)) {
+    sleep();
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const auto waited = [&start] {
+    return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  };
+  bool done = false;
+  while (budget > 0.0) {
+    for (int k = 0; k < 64 && !done; ++k) {
+      pause();
+      done = ready();
+    }
+    if (done || waited() > budget) break;
+  }
+  if (!done) sleep();
+  budget = waited() <= limit ? std::min(limit, 2.0 * budget + 1.0) : (budget > 1.0 ? 0.5 * budget : 0.0);
+}
+
+void CapeGroup::runWorker() {
   std::uint64_t seen = 0;
+  double budget = 0.0;  // grows to the setting over the first short waits (waitUntil)
   const auto due = [&] {
     return stopping_.load(std::memory_order_acquire) || generation_.load(std::memory_order_acquire) != seen;
   };
   for (;;) {
-    // Spin for the next step first; then sleep. The generation changes under the mutex and the sleep checks
-    // it under the mutex, so a step begun between the spin and the sleep is not missed.
-    if (!spinUntil(due)) {
-      std::unique_lock<std::mutex> lock(mutex_);
-      start_.wait(lock, due);
-    }
+    // The generation changes under the mutex and the sleep checks it under the mutex, so a step begun
+    // between the spin and the sleep is not missed.
+    waitUntil(
+        due,
+        [&] {
+          std::unique_lock<std::mutex> lock(mutex_);
+          start_.wait(lock, due);
+        },
+        budget);
     if (stopping_.load(std::memory_order_acquire)) return;
     seen = generation_.load(std::memory_order_acquire);
-    work(worker);
-    // The last worker to finish wakes the calling thread if it sleeps (notified under the mutex, which the
-    // calling thread holds from its check of pending_ until it sleeps: no lost wake-up).
-    if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      done_.notify_one();
-    }
+    work();
   }
 }
 
@@ -104,6 +129,7 @@ Status CapeGroup::setSpinMicroseconds(double microseconds) {
   if (!std::isfinite(microseconds) || microseconds < 0.0 || microseconds > 1e6)
     return Status::error("CapeGroup::setSpinMicroseconds: the spin must be finite, in [0, 1e6] us");
   spinMicroseconds_.store(microseconds, std::memory_order_relaxed);
+  spinBudget_ = microseconds;  // the workers' budgets follow at their next short wait
   return Status::success();
 }
 
@@ -179,18 +205,26 @@ void CapeGroup::updateAction(btCollisionWorld* world, btScalar dt) {
     for (CapeAction* cape : capes_) cape->advance(dt);
   } else {
     for (CapeAction* cape : capes_) cape->deferWarnings_ = parallel;
-    pending_.store(static_cast<int>(threads_.size()), std::memory_order_relaxed);
+    // Whoever is free takes the next cape: a worker that wakes late leaves its share to the others instead
+    // of holding the step up. Each cape is stepped whole by one thread, in its own state, so the results
+    // do not depend on which.
+    const std::uint64_t count = capes_.size();
+    finished_.store(0, std::memory_order_relaxed);
+    claim_.store(count << 32, std::memory_order_release);  // publishes the step's inputs to late claims
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      generation_.fetch_add(1, std::memory_order_release);  // publishes pending_ and the step's inputs
+      generation_.fetch_add(1, std::memory_order_release);
     }
     start_.notify_all();
-    work(0);
-    const auto finished = [&] { return pending_.load(std::memory_order_acquire) == 0; };
-    if (!spinUntil(finished)) {
-      std::unique_lock<std::mutex> lock(mutex_);
-      done_.wait(lock, finished);
-    }
+    work();
+    const auto finished = [&] { return finished_.load(std::memory_order_acquire) == count; };
+    waitUntil(
+        finished,
+        [&] {
+          std::unique_lock<std::mutex> lock(mutex_);
+          done_.wait(lock, finished);
+        },
+        spinBudget_);
     world_ = nullptr;
     for (CapeAction* cape : capes_) {
       cape->deferWarnings_ = false;

@@ -1,12 +1,13 @@
 /// \file
 /// CapeGroup: several capes stepped with one Bullet world, in parallel. Add the group to the world
 /// (world->addAction(&group)) instead of each cape. Every internal step, the group prepares each cape on the
-/// calling thread (reading the world is not shared out), then advances them on a small persistent pool:
-/// cape i always runs on worker i % threadCount (a fixed static partition). Each cape is independent and its
-/// own computation is sequential, so the results are bitwise identical whatever the thread count. The
-/// hand-offs between the calling thread and the workers (every internal step) spin for a while before they
-/// sleep (setSpinMicroseconds): a wake-up from sleep costs tens of microseconds, as much as a small crowd's
-/// step.
+/// calling thread (reading the world is not shared out), then advances them on a small persistent pool,
+/// whose threads (the calling one among them) take the capes one at a time until none is left, so a worker
+/// that wakes late or a cape that costs more does not hold the others up. Each cape is independent and
+/// stepped whole by one thread, so the results are bitwise identical whatever the thread count and
+/// whichever thread steps it. The
+/// hand-offs between the calling thread and the workers (every internal step) sleep on condition variables,
+/// or spin for a while first (setSpinMicroseconds).
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
@@ -42,7 +43,7 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   /// Removes a cape from the group (not destroyed; nothing happens if it is not a member). It keeps the
   /// level of detail it had.
   void remove(CapeAction* cape);
-  /// The member capes, in the order they were added (cape i runs on worker i % threadCount()).
+  /// The member capes, in the order they were added.
   const std::vector<CapeAction*>& capes() const { return capes_; }
   /// Workers in all, the calling thread included.
   int threadCount() const { return threadCount_; }
@@ -72,11 +73,11 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   const std::vector<std::size_t>& detailCounts() const { return bandCounts_; }
 
   // --- Parallel prepare --------------------------------------------------------------------------------
-  /// Prepare the capes on the pool too (off by default): each worker prepares and then advances its own
-  /// capes, with no wait between the two halves, instead of every prepare() running first on the calling
-  /// thread. The results are the same bits. It needs the world's shapes to answer queries from several
-  /// threads at once, as Bullet's own do during actions: the broadphase's AABB test keeps its traversal
-  /// stack on the caller's stack, and btBvhTriangleMeshShape's and btHeightfieldTerrainShape's
+  /// Prepare the capes on the pool too (off by default): the thread that takes a cape prepares and then
+  /// advances it, with no wait between the two halves, instead of every prepare() running first on the
+  /// calling thread. The results are the same bits. It needs the world's shapes to answer queries from
+  /// several threads at once, as Bullet's own do during actions: the broadphase's AABB test keeps its
+  /// traversal stack on the caller's stack, and btBvhTriangleMeshShape's and btHeightfieldTerrainShape's
   /// processAllTriangles only read (a mesh interface of your own that locks or caches must allow it). The
   /// capes' warnings are held back and given to their handlers on the calling thread, cape by cape, after
   /// the step.
@@ -86,26 +87,30 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
 
   // --- Hand-offs ---------------------------------------------------------------------------------------
   /// How long a worker waiting for the next internal step, and the calling thread waiting for the workers to
-  /// finish one, spin (checking a flag, with a pause instruction) before they sleep on a condition variable,
-  /// microseconds; 0: sleep at once. Spinning keeps the hand-offs of one frame's internal steps from paying
-  /// a sleep's wake-up each; it costs a core while it lasts, so a machine with fewer cores than the group's
-  /// threads and other busy threads may want 0. The results are the same bits either way. An error,
-  /// keeping the value in use, for a value not finite or outside [0, 1e6]. Default: kDefaultSpinMicroseconds.
+  /// finish one, may spin (checking a flag, with a pause instruction) before they sleep on a condition
+  /// variable, microseconds; 0 (the default): sleep at once. A wake-up from sleep costs tens of microseconds
+  /// at every hand-off, as much as a small crowd's step, and spinning saves it where the group's threads
+  /// have cores of their own; where they have not (more busy threads than cores), a spinning thread holds
+  /// the core that the one it waits for needs. Each thread adapts its own spin: a wait longer than the
+  /// setting halves its next spin, a shorter one doubles it (up to the setting). The results are the same
+  /// bits either way. An error, keeping the value in use, for a value not finite or outside [0, 1e6].
   Status setSpinMicroseconds(double microseconds);
-  /// The spin before sleeping, microseconds (setSpinMicroseconds).
+  /// The longest spin before sleeping, microseconds (setSpinMicroseconds).
   double spinMicroseconds() const { return spinMicroseconds_.load(std::memory_order_relaxed); }
-  static constexpr double kDefaultSpinMicroseconds = 200.0;
+  static constexpr double kDefaultSpinMicroseconds = 0.0;
 
   /// Wall time of the last parallel advance of all capes (with their prepare under setParallelPrepare),
   /// microseconds.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
 
  private:
-  void work(int worker);
-  void runWorker(int worker);
-  /// Spins up to spinMicroseconds_ until `ready()`; true if it came true (then no sleep is needed).
-  template <class Ready>
-  bool spinUntil(Ready ready) const;
+  /// Steps the capes of the current step that no thread has taken yet, one at a time.
+  void work();
+  void runWorker();
+  /// Waits until `ready()`: spins up to `budget` us, then calls `sleep()` (which waits on a condition
+  /// variable); then sets `budget` for the next wait (see the definition).
+  template <class Ready, class Sleep>
+  void waitUntil(Ready ready, Sleep sleep, double& budget) const;
   void applyDetailPolicy();
 
   std::vector<CapeAction*> capes_;
@@ -116,10 +121,14 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   std::condition_variable done_;
   /// Incremented for every parallel step (written under mutex_, read by spinning workers without it).
   std::atomic<std::uint64_t> generation_{0};
-  std::atomic<int> pending_{0};        ///< Workers (threads) still busy with the current step.
-  std::atomic<bool> stopping_{false};  ///< Written under mutex_.
+  /// The current step's claims: its cape count (high 32 bits) and the next cape to take (low 32 bits).
+  std::atomic<std::uint64_t> claim_{0};
+  std::atomic<std::uint64_t> finished_{0};  ///< Capes of the current step finished.
+  std::atomic<bool> stopping_{false};       ///< Written under mutex_.
   /// Read by the workers while they wait, so atomic (relaxed: it orders nothing).
   std::atomic<double> spinMicroseconds_{kDefaultSpinMicroseconds};
+  double spinBudget_ =
+      kDefaultSpinMicroseconds;  ///< The calling thread's (waitUntil); the workers keep theirs.
   btScalar dt_ = 0;
   btCollisionWorld* world_ = nullptr;  ///< The world of the step in progress (parallel prepare).
   bool parallelPrepare_ = false;
