@@ -7,9 +7,10 @@
 //
 // Reported per frame (means over the timed frames; _p50 their medians):
 //   cape_us           the capes' wall time: the group's updateAction calls (every cape's prepare on the
-//                     calling thread, then the parallel advance), timed from outside the group
-//   advance_us        the group's own lastStepMicroseconds, summed over the frame's internal steps (the
-//                     parallel advance alone)
+//                     calling thread, and the parallel advance), timed from outside the group
+//   advance_us        the group's own lastStepMicroseconds, summed over the frame's internal steps (on
+//                     one thread the advances alone; on more, the pool's part, the prepares on the calling
+//                     thread that overlap it included)
 //   cape_per_cape_us  cape_us / K
 //   bullet_us         Bullet's own share: stepSimulation's wall time less cape_us
 //   frame_us          stepSimulation's wall time

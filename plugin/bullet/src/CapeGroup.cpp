@@ -62,6 +62,13 @@ void CapeGroup::work() {
     const std::uint64_t word = claim_.fetch_add(1, std::memory_order_acq_rel);
     const std::uint64_t count = word >> 32, i = word & 0xffffffffu;
     if (i >= count) return;
+    // A cape the calling thread prepares (the prepares not on the pool) is advanced once it is: a wait of
+    // at most a few prepares, spent checking (and, should the calling thread have lost its core, giving
+    // this one away).
+    for (int k = 0; prepared_.load(std::memory_order_acquire) <= i; ++k) {
+      pause();
+      if ((k & 63) == 63) std::this_thread::yield();
+    }
     CapeAction* cape = capes_[static_cast<std::size_t>(i)];
     if (world_ != nullptr) cape->prepare(world_, dt_);  // a parallel prepare
     cape->advance(dt_);
@@ -194,42 +201,52 @@ void CapeGroup::applyDetailPolicy() {
 
 void CapeGroup::updateAction(btCollisionWorld* world, btScalar dt) {
   if (!bands_.empty()) applyDetailPolicy();
-  const bool parallel = parallelPrepare_ && !threads_.empty() && capes_.size() >= 2;
-  // Reading the world (bodies, discovery) stays on this thread, unless asked otherwise.
-  world_ = parallel ? world : nullptr;
-  if (!parallel)
-    for (CapeAction* cape : capes_) cape->prepare(world, dt);
-  const auto start = std::chrono::steady_clock::now();
   dt_ = dt;
   if (threads_.empty() || capes_.size() < 2) {
+    for (CapeAction* cape : capes_) cape->prepare(world, dt);
+    const auto start = std::chrono::steady_clock::now();
     for (CapeAction* cape : capes_) cape->advance(dt);
-  } else {
-    for (CapeAction* cape : capes_) cape->deferWarnings_ = parallel;
-    // Whoever is free takes the next cape: a worker that wakes late leaves its share to the others instead
-    // of holding the step up. Each cape is stepped whole by one thread, in its own state, so the results
-    // do not depend on which.
-    const std::uint64_t count = capes_.size();
-    finished_.store(0, std::memory_order_relaxed);
-    claim_.store(count << 32, std::memory_order_release);  // publishes the step's inputs to late claims
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      generation_.fetch_add(1, std::memory_order_release);
+    lastStepMicroseconds_ =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    return;
+  }
+  // Reading the world (bodies, discovery) stays on this thread, unless asked otherwise.
+  const bool parallel = parallelPrepare_;
+  world_ = parallel ? world : nullptr;
+  for (CapeAction* cape : capes_) cape->deferWarnings_ = parallel;
+  // Whoever is free takes the next cape: a worker that wakes late leaves its share to the others instead of
+  // holding the step up. Each cape is stepped whole by one thread, in its own state, so the results do not
+  // depend on which. Unless the prepares are on the pool, this thread prepares the capes in order while the
+  // workers advance those already prepared (work() waits for a cape's prepare), then takes what is left.
+  const std::uint64_t count = capes_.size();
+  finished_.store(0, std::memory_order_relaxed);
+  prepared_.store(parallel ? count : 0, std::memory_order_relaxed);
+  const auto start = std::chrono::steady_clock::now();
+  claim_.store(count << 32, std::memory_order_release);  // publishes the step's inputs to late claims
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    generation_.fetch_add(1, std::memory_order_release);
+  }
+  start_.notify_all();
+  if (!parallel) {
+    for (std::uint64_t i = 0; i < count; ++i) {
+      capes_[static_cast<std::size_t>(i)]->prepare(world, dt);
+      prepared_.store(i + 1, std::memory_order_release);
     }
-    start_.notify_all();
-    work();
-    const auto finished = [&] { return finished_.load(std::memory_order_acquire) == count; };
-    waitUntil(
-        finished,
-        [&] {
-          std::unique_lock<std::mutex> lock(mutex_);
-          done_.wait(lock, finished);
-        },
-        spinBudget_);
-    world_ = nullptr;
-    for (CapeAction* cape : capes_) {
-      cape->deferWarnings_ = false;
-      cape->sayDeferredWarnings();
-    }
+  }
+  work();
+  const auto finished = [&] { return finished_.load(std::memory_order_acquire) == count; };
+  waitUntil(
+      finished,
+      [&] {
+        std::unique_lock<std::mutex> lock(mutex_);
+        done_.wait(lock, finished);
+      },
+      spinBudget_);
+  world_ = nullptr;
+  for (CapeAction* cape : capes_) {
+    cape->deferWarnings_ = false;
+    cape->sayDeferredWarnings();
   }
   lastStepMicroseconds_ =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();

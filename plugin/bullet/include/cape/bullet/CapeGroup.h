@@ -1,13 +1,13 @@
 /// \file
 /// CapeGroup: several capes stepped with one Bullet world, in parallel. Add the group to the world
 /// (world->addAction(&group)) instead of each cape. Every internal step, the group prepares each cape on the
-/// calling thread (reading the world is not shared out), then advances them on a small persistent pool,
-/// whose threads (the calling one among them) take the capes one at a time until none is left, so a worker
-/// that wakes late or a cape that costs more does not hold the others up. Each cape is independent and
-/// stepped whole by one thread, so the results are bitwise identical whatever the thread count and
-/// whichever thread steps it. The
-/// hand-offs between the calling thread and the workers (every internal step) sleep on condition variables,
-/// or spin for a while first (setSpinMicroseconds).
+/// calling thread, in order (reading the world is not shared out), while a small persistent pool advances
+/// the capes already prepared: its threads (the calling one among them, once it has prepared them all)
+/// take the capes one at a time until none is left, so a worker that wakes late or a cape that costs more
+/// does not hold the others up. Each cape is independent and stepped whole by one thread, so the results
+/// are bitwise identical whatever the thread count and whichever thread steps it. The hand-offs between the
+/// calling thread and the workers (every internal step) sleep on condition variables, or spin for a while
+/// first (setSpinMicroseconds).
 #pragma once
 
 #include "cape/bullet/CapeAction.h"
@@ -48,8 +48,8 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   /// Workers in all, the calling thread included.
   int threadCount() const { return threadCount_; }
 
-  /// One internal step of the world (dt s): every cape's prepare() on this thread, then their advance() on
-  /// the pool.
+  /// One internal step of the world (dt s): every cape's prepare() on this thread, in order, and their
+  /// advance() on the pool as soon as each is prepared.
   void updateAction(btCollisionWorld* world, btScalar dt) override;
   /// Draws every member cape (CapeAction::debugDraw).
   void debugDraw(btIDebugDraw* drawer) override;
@@ -74,13 +74,12 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
 
   // --- Parallel prepare --------------------------------------------------------------------------------
   /// Prepare the capes on the pool too (off by default): the thread that takes a cape prepares and then
-  /// advances it, with no wait between the two halves, instead of every prepare() running first on the
-  /// calling thread. The results are the same bits. It needs the world's shapes to answer queries from
-  /// several threads at once, as Bullet's own do during actions: the broadphase's AABB test keeps its
-  /// traversal stack on the caller's stack, and btBvhTriangleMeshShape's and btHeightfieldTerrainShape's
-  /// processAllTriangles only read (a mesh interface of your own that locks or caches must allow it). The
-  /// capes' warnings are held back and given to their handlers on the calling thread, cape by cape, after
-  /// the step.
+  /// advances it, instead of every prepare() running on the calling thread. The results are the same bits. It
+  /// needs the world's shapes to answer queries from several threads at once, as Bullet's own do during
+  /// actions: the broadphase's AABB test keeps its traversal stack on the caller's stack, and
+  /// btBvhTriangleMeshShape's and btHeightfieldTerrainShape's processAllTriangles only read (a mesh interface
+  /// of your own that locks or caches must allow it). The capes' warnings are held back and given to their
+  /// handlers on the calling thread, cape by cape, after the step.
   void setParallelPrepare(bool parallel) { parallelPrepare_ = parallel; }
   /// Whether the capes are prepared on the pool (setParallelPrepare).
   bool parallelPrepare() const { return parallelPrepare_; }
@@ -99,8 +98,9 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   double spinMicroseconds() const { return spinMicroseconds_.load(std::memory_order_relaxed); }
   static constexpr double kDefaultSpinMicroseconds = 0.0;
 
-  /// Wall time of the last parallel advance of all capes (with their prepare under setParallelPrepare),
-  /// microseconds.
+  /// Wall time of the last internal step's work on the pool, microseconds: from the hand-off to the last
+  /// cape's finish, the prepares on the calling thread that overlap it included. With one thread (or fewer
+  /// than two capes), the advances alone.
   double lastStepMicroseconds() const { return lastStepMicroseconds_; }
 
  private:
@@ -124,6 +124,7 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   /// The current step's claims: its cape count (high 32 bits) and the next cape to take (low 32 bits).
   std::atomic<std::uint64_t> claim_{0};
   std::atomic<std::uint64_t> finished_{0};  ///< Capes of the current step finished.
+  std::atomic<std::uint64_t> prepared_{0};  ///< Capes of the current step prepared (the first ones).
   std::atomic<bool> stopping_{false};       ///< Written under mutex_.
   /// Read by the workers while they wait, so atomic (relaxed: it orders nothing).
   std::atomic<double> spinMicroseconds_{kDefaultSpinMicroseconds};
