@@ -81,8 +81,8 @@ void CapeGroup::work() {
   }
 }
 
-template <class Ready, class Sleep>
-void CapeGroup::waitUntil(Ready ready, Sleep sleep, double& budget) const {
+template <class Ready>
+void CapeGroup::waitUntil(Ready ready, std::condition_variable& wake, double& budget) {
   // Spin while the budget lasts (the clock read every 64 checks: a check is a load, the clock tens of
   // nanoseconds), then sleep. A wait no longer than the setting doubles the next one's budget (up to the
   // setting) and a longer one halves it, so that where the waits are long, or the thread waited for has no
@@ -90,24 +90,24 @@ void CapeGroup::waitUntil(Ready ready, Sleep sleep, double& budget) const {
   // anything and the thread sleeps at once; a sleeper is woken ahead of a thread that spins or yields.
   if (ready()) return;
   const double limit = spinMicroseconds_.load(std::memory_order_relaxed);
-  if (!(limit > 0.0)) {
-    sleep();
-    return;
-  }
   const auto start = std::chrono::steady_clock::now();
   const auto waited = [&start] {
     return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   };
   bool done = false;
-  while (budget > 0.0) {
+  while (limit > 0.0 && budget > 0.0) {
     for (int k = 0; k < 64 && !done; ++k) {
       pause();
       done = ready();
     }
     if (done || waited() > budget) break;
   }
-  if (!done) sleep();
-  budget = waited() <= limit ? std::min(limit, 2.0 * budget + 1.0) : (budget > 1.0 ? 0.5 * budget : 0.0);
+  if (!done) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake.wait(lock, ready);
+  }
+  if (limit > 0.0)
+    budget = waited() <= limit ? std::min(limit, 2.0 * budget + 1.0) : (budget > 1.0 ? 0.5 * budget : 0.0);
 }
 
 void CapeGroup::runWorker() {
@@ -119,13 +119,7 @@ void CapeGroup::runWorker() {
   for (;;) {
     // The generation changes under the mutex and the sleep checks it under the mutex, so a step begun
     // between the spin and the sleep is not missed.
-    waitUntil(
-        due,
-        [&] {
-          std::unique_lock<std::mutex> lock(mutex_);
-          start_.wait(lock, due);
-        },
-        budget);
+    waitUntil(due, start_, budget);
     if (stopping_.load(std::memory_order_acquire)) return;
     seen = generation_.load(std::memory_order_acquire);
     work();
@@ -236,13 +230,7 @@ void CapeGroup::updateAction(btCollisionWorld* world, btScalar dt) {
   }
   work();
   const auto finished = [&] { return finished_.load(std::memory_order_acquire) == count; };
-  waitUntil(
-      finished,
-      [&] {
-        std::unique_lock<std::mutex> lock(mutex_);
-        done_.wait(lock, finished);
-      },
-      spinBudget_);
+  waitUntil(finished, done_, spinBudget_);
   world_ = nullptr;
   for (CapeAction* cape : capes_) {
     cape->deferWarnings_ = false;

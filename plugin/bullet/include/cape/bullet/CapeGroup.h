@@ -107,10 +107,10 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   /// Steps the capes of the current step that no thread has taken yet, one at a time.
   void work();
   void runWorker();
-  /// Waits until `ready()`: spins up to `budget` us, then calls `sleep()` (which waits on a condition
-  /// variable); then sets `budget` for the next wait (see the definition).
-  template <class Ready, class Sleep>
-  void waitUntil(Ready ready, Sleep sleep, double& budget) const;
+  /// Waits until `ready()`: spins up to `budget` us, then sleeps on `wake` (under mutex_); then sets
+  /// `budget` for the next wait (see the definition).
+  template <class Ready>
+  void waitUntil(Ready ready, std::condition_variable& wake, double& budget);
   void applyDetailPolicy();
 
   std::vector<CapeAction*> capes_;
