@@ -39,9 +39,11 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   CapeGroup& operator=(const CapeGroup&) = delete;
 
   /// Adds a cape (not owned; it must outlive its membership and must not be added to the world itself).
+  /// Members are added and removed between steps, not from inside one (a cape's warning handler, called
+  /// during the step, must not change the group: the other capes are being stepped on the pool).
   void add(CapeAction* cape);
   /// Removes a cape from the group (not destroyed; nothing happens if it is not a member). It keeps the
-  /// level of detail it had.
+  /// level of detail it had. Between steps, as add().
   void remove(CapeAction* cape);
   /// The member capes, in the order they were added.
   const std::vector<CapeAction*>& capes() const { return capes_; }
