@@ -98,6 +98,8 @@ class CAPE_BULLET_API CapeGroup : public btActionInterface {
   Status setSpinMicroseconds(double microseconds);
   /// The longest spin before sleeping, microseconds (setSpinMicroseconds).
   double spinMicroseconds() const { return spinMicroseconds_.load(std::memory_order_relaxed); }
+  /// The spin a group starts with: none (sleep at once), as spinning costs where other threads need the
+  /// cores.
   static constexpr double kDefaultSpinMicroseconds = 0.0;
 
   /// Wall time of the last internal step's work on the pool, microseconds: from the hand-off to the last
