@@ -48,6 +48,8 @@ json settingsJson(const CapeSettings& s) {
           {"time_step_s", s.timeStep},
           {"strain_limit", s.strainLimit},
           {"max_refinement", s.maxRefinement},
+          {"strain_ceiling", s.strainCeiling},
+          {"strain_ceiling_passes", s.strainCeilingPasses},
           {"iterations", s.iterations},
           {"gravity", vec(s.gravity)},
           {"wind", wind},

@@ -76,7 +76,8 @@ int main(int argc, char** argv) {
       "bad command line.");
   SceneCli sceneCli;
   std::string solver = "xpbd", out;
-  int threads = 1, substeps = -1, maxRefinement = -1;
+  int threads = 1, substeps = -1, maxRefinement = -1, strainPasses = 1;
+  double strainCeiling = 0.0;
   std::int64_t framesEvery = 1;
   bool writeFrames = false, noFrames = false, noRender = false, selfCollision = false;
   addSceneOptions(app, sceneCli);
@@ -101,6 +102,16 @@ int main(int argc, char** argv) {
          "up to N times the substeps (default: the solver's, 4; 1: never refine; a 64 x 64 cape in a "
          "sprint needs 16 to stay within 10 %, docs/PERFORMANCE.md)")
       ->transform(strictInteger(1, 64));
+  app.add_option("--strain-ceiling", strainCeiling,
+                 "strain limiting: the most a structural spring may stretch, as a strain (0.1: 10 %), held "
+                 "after the springs' solve (CapeSettings::strainCeiling; 0: off)")
+      ->transform(strictReal(0.0, 10.0))
+      ->capture_default_str();
+  app.add_option("--strain-passes", strainPasses,
+                 "with --strain-ceiling, passes over the structural springs per iteration "
+                 "(CapeSettings::strainCeilingPasses)")
+      ->transform(strictInteger(1, 64))
+      ->capture_default_str();
   bool noSelfCollision = false;
   app.add_flag("--self-collision", selfCollision,
                "keep the cape from passing through itself (default: on for --cape cape, off for canonical)");
@@ -235,6 +246,8 @@ int main(int argc, char** argv) {
   }
   if (substeps > 0) o.settings.substeps = substeps;
   if (maxRefinement > 0) o.settings.maxRefinement = maxRefinement;
+  o.settings.strainCeiling = static_cast<float>(strainCeiling);
+  o.settings.strainCeilingPasses = strainPasses;
   // The folding cape collides with itself unless told not to; the canonical one only when asked.
   o.settings.selfCollision = selfCollision || (!noSelfCollision && o.capeStyle == "cape");
   if (Status s = o.settings.validate(); !s.ok()) {

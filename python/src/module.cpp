@@ -177,6 +177,10 @@ void bindSettings(py::module_& m) {
       .def_readwrite("strain_limit", &cape::CapeSettings::strainLimit,
                      "Adaptive substepping threshold, 0 = off.")
       .def_readwrite("max_refinement", &cape::CapeSettings::maxRefinement)
+      .def_readwrite("strain_ceiling", &cape::CapeSettings::strainCeiling,
+                     "Strain limiting: the most a structural spring may stretch, 0..10 (0 = off).")
+      .def_readwrite("strain_ceiling_passes", &cape::CapeSettings::strainCeilingPasses,
+                     "Passes over the structural springs per iteration, 1..64.")
       .def_readwrite("guard_reach", &cape::CapeSettings::guardReach,
                      "Rest diameters beyond the farthest pin.")
       .def_readwrite("sleep_speed", &cape::CapeSettings::sleepSpeed, "m/s; 0 never sleeps.")

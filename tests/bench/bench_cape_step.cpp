@@ -103,6 +103,18 @@ void BM_SprintTurnFrame(benchmark::State& state) {
 void BM_SprintTurnFrameFixed(benchmark::State& state) {
   runFrames(state, SceneKind::SprintTurn, fixedSubsteps());
 }
+// Strain limiting (CapeSettings::strainCeiling, 10 %, one pass) beside BM_SprintTurnFrame and
+// BM_WalkFrame: what the pass costs, and what the refinement it spares saves.
+void BM_SprintTurnFrameStrainCeiling(benchmark::State& state) {
+  CapeSettings s;
+  s.strainCeiling = 0.1f;
+  runFrames(state, SceneKind::SprintTurn, s);
+}
+void BM_WalkFrameStrainCeiling(benchmark::State& state) {
+  CapeSettings s = fixedSubsteps();
+  s.strainCeiling = 0.1f;
+  runFrames(state, SceneKind::Walk, s);
+}
 void BM_WalkFrameSeedExplicit(benchmark::State& state) {
   CapeSettings s = CapeSettings::unitySeed();
   s.timeStep = 1.0f / 60.0f;
@@ -150,7 +162,9 @@ BENCHMARK(BM_WalkFrameSimd)
 BENCHMARK(BM_WalkFrameSelfCollision)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SprintTurnFrameSelfCollision)->Arg(20)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SprintTurnFrameSelfCollisionOff)->Arg(32)->Arg(64)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_SprintTurnFrame)->Arg(20)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SprintTurnFrame)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SprintTurnFrameFixed)->Arg(20)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SprintTurnFrameStrainCeiling)->Arg(20)->Arg(64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WalkFrameStrainCeiling)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WalkFrameSeedExplicit)->Arg(20)->Unit(benchmark::kMicrosecond);
 BENCHMARK_MAIN();

@@ -296,6 +296,35 @@ TEST(SpringSolver, TheLargestStretchReadRunByRunIsTheScalarLoops) {
   }
 }
 
+TEST(SpringSolver, TheStrainCeilingCheckedRunByRunGivesTheScalarLoopsBits) {
+  // Strain limiting (CapeSettings::strainCeiling) over every family's runs, blocks checked four at a time:
+  // the same bits as the scalar loop over the whole set, with pinned, coincident and non-finite particles
+  // among them, at a ceiling most springs are under (5 % stretched by the jitter's 1.05: a few blocks to
+  // correct) and one every spring is over (0: every block).
+  for (const FabricPtr& fabric : fabrics()) {
+    ASSERT_TRUE(fabric);
+    for (const float ceiling : {0.08f, 0.0f}) {
+      for (int family = 0; family < kSpringFamilyCount; ++family) {
+        const SpringSet& set = fabric->springs(static_cast<SpringFamily>(family));
+        KernelState vector = jittered(*fabric, 17), scalar = vector;
+        const KernelState start = vector;
+        for (int pass = 0; pass < 3; ++pass) {
+          detail::limitStretch(vector.x.data(), vector.y.data(), vector.z.data(), vector.w.data(), set,
+                               1.0f + ceiling);
+          detail::limitStretchScalar(scalar.x.data(), scalar.y.data(), scalar.z.data(), scalar.w.data(), set,
+                                     0, set.size(), 1.0f + ceiling);
+        }
+        EXPECT_TRUE(sameBits(vector.x, scalar.x) && sameBits(vector.y, scalar.y) &&
+                    sameBits(vector.z, scalar.z))
+            << "family " << family << ", ceiling " << ceiling;
+        if (set.size() > 0) {
+          EXPECT_FALSE(sameBits(vector.x, start.x) && sameBits(vector.y, start.y)) << "nothing was corrected";
+        }
+      }
+    }
+  }
+}
+
 TEST(SimdLevels, TheWidestIsTheDefaultAndALevelTheProcessorLacksIsRefused) {
   const SimdLevel before = simdLevel();
   EXPECT_TRUE(setSimdLevel(SimdLevel::Portable).ok());  // every processor runs the portable kernels

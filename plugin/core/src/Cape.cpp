@@ -828,7 +828,8 @@ void Cape::predict(float h) {
 
 void Cape::solveConstraints(float h) {
   // Tethers first (they fix the global stretch in one pass), then the springs, which are left with only
-  // local corrections, then the self-contacts. Collisions come after, so the cape ends every substep outside
+  // local corrections, then the strain ceiling over those still stretched beyond it, then the hinges and the
+  // self-contacts. Collisions come after, so the cape ends every substep outside
   // the colliders.
   // The multipliers start every substep at zero; with one iteration they are never read again, so none is
   // kept (SpringSolveArrays::lambda null).
@@ -840,6 +841,12 @@ void Cape::solveConstraints(float h) {
   for (int it = 0; it < settings_.iterations; ++it) {
     if (settings_.useTethers) solveTethers();
     solveSprings(h);
+    if (settings_.strainCeiling > 0.0f) {
+      for (int pass = 0; pass < settings_.strainCeilingPasses; ++pass)
+        detail::limitStretch(state_.positions.col(0).data(), state_.positions.col(1).data(),
+                             state_.positions.col(2).data(), state_.inverseMasses.data(),
+                             fabric_->springs(SpringFamily::Structural), 1.0f + settings_.strainCeiling);
+    }
     if (bending) {
       detail::solveHinges(state_.positions.col(0).data(), state_.positions.col(1).data(),
                           state_.positions.col(2).data(), state_.inverseMasses.data(), fabric_->hinges(),

@@ -60,6 +60,10 @@ Status CapeSettings::validate() const {
     return Status::error("CapeSettings: strainLimit must be finite and >= 0");
   if (maxRefinement < 1 || maxRefinement > 64)
     return Status::error("CapeSettings: maxRefinement must be in 1..64");
+  if (!(std::isfinite(strainCeiling) && strainCeiling >= 0.0f && strainCeiling <= 10.0f))
+    return Status::error("CapeSettings: strainCeiling must be in 0..10 (a strain; 0 = no strain limiting)");
+  if (strainCeilingPasses < 1 || strainCeilingPasses > 64)
+    return Status::error("CapeSettings: strainCeilingPasses must be in 1..64");
   if (iterations < 1 || iterations > 1000)
     return Status::error("CapeSettings: iterations must be in 1..1000");
   if (!gravity.allFinite()) return Status::error("CapeSettings: gravity must be finite");

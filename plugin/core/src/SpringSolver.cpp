@@ -96,6 +96,34 @@ void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMas
   }
 }
 
+void limitStretchScalar(float* px, float* py, float* pz, const float* inverseMass, const SpringSet& set,
+                        std::size_t begin, std::size_t end, float stretch) {
+  // A branch, not a select: under ordinary motion few springs are over the ceiling, and the branch skips
+  // the square root and the division for the rest.
+  const float* __restrict w = inverseMass;
+  const std::uint32_t* __restrict first = set.first.data();
+  const std::uint32_t* __restrict second = set.second.data();
+  const float* __restrict rest = set.restLength.data();
+  for (std::size_t s = begin; s < end; ++s) {
+    const std::uint32_t i = first[s], j = second[s];
+    const float dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
+    const float len2 = dx * dx + dy * dy + dz * dz;
+    const float maxLen = stretch * rest[s];
+    const float wsum = w[i] + w[j];
+    if (!(len2 > maxLen * maxLen) || !(wsum > 0.0f)) continue;
+    const float len = std::sqrt(len2);
+    // The length to remove per unit of d = xj - xi, shared as wi : wj.
+    const float k = (len - maxLen) / (len * wsum);
+    const float ki = w[i] * k, kj = w[j] * k;
+    px[i] += ki * dx;
+    py[i] += ki * dy;
+    pz[i] += ki * dz;
+    px[j] -= kj * dx;
+    py[j] -= kj * dy;
+    pz[j] -= kj * dz;
+  }
+}
+
 float maxSquaredStretchScalar(const float* px, const float* py, const float* pz, const SpringSet& set,
                               std::size_t begin, std::size_t end, float worst) {
   for (std::size_t s = begin; s < end; ++s) {
@@ -507,6 +535,44 @@ float maxSquaredStretch(const float* px, const float* py, const float* pz, const
   return worst;
 }
 
+namespace {
+
+// limitStretch over one vector run: each block's four lengths against the ceiling as the scalar loop
+// computes them (the same operations in the same order, so the same bits), and the scalar loop over the
+// block only where a lane is beyond it. The block's springs share no particle, so the blocks in order are
+// the springs in order.
+template <SpringLayout L>
+void limitBlocks(float* px, float* py, float* pz, const float* inverseMass, const SpringSet& set,
+                 const SpringRun& run, float stretch) {
+  using In = Lanes<L>;
+  const __m128 factor = _mm_set1_ps(stretch);
+  for (std::uint32_t s = run.begin; s < run.end; s += 4) {
+    const std::uint32_t* p = set.first.data() + s;
+    const std::uint32_t* q = set.second.data() + s;
+    __m128 xi, xj, yi, yj, zi, zj;
+    In::load(px, p, q, xi, xj);
+    In::load(py, p, q, yi, yj);
+    In::load(pz, p, q, zi, zj);
+    const __m128 dx = _mm_sub_ps(xj, xi), dy = _mm_sub_ps(yj, yi), dz = _mm_sub_ps(zj, zi);
+    const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 maxLen = _mm_mul_ps(factor, _mm_loadu_ps(set.restLength.data() + s));
+    if (_mm_movemask_ps(_mm_cmpgt_ps(len2, _mm_mul_ps(maxLen, maxLen))) != 0)
+      limitStretchScalar(px, py, pz, inverseMass, set, s, s + 4, stretch);
+  }
+}
+
+}  // namespace
+
+void limitStretch(float* px, float* py, float* pz, const float* inverseMass, const SpringSet& set,
+                  float stretch) {
+  for (const SpringRun& run : set.runs) {
+    const bool vector = withVectorLayout(run.layout, [&](auto layout) {
+      limitBlocks<decltype(layout)::value>(px, py, pz, inverseMass, set, run, stretch);
+    });
+    if (!vector) limitStretchScalar(px, py, pz, inverseMass, set, run.begin, run.end, stretch);
+  }
+}
+
 void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {
   if (a.complianceScale != nullptr) {
     if (a.lambda != nullptr)
@@ -528,6 +594,11 @@ void solveTethers(float* px, float* py, float* pz, const float* inverseMass, con
 
 float maxSquaredStretch(const float* px, const float* py, const float* pz, const SpringSet& set) {
   return maxSquaredStretchScalar(px, py, pz, set, 0, set.size());
+}
+
+void limitStretch(float* px, float* py, float* pz, const float* inverseMass, const SpringSet& set,
+                  float stretch) {
+  limitStretchScalar(px, py, pz, inverseMass, set, 0, set.size(), stretch);
 }
 
 void solveSpringRun(const SpringSolveArrays& a, const SpringRun& run, float alphaTilde) {

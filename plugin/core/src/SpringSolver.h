@@ -65,6 +65,19 @@ void solveTethersScalar(float* px, float* py, float* pz, const float* inverseMas
 /// read nothing the others write.
 void solveTethers(float* px, float* py, float* pz, const float* inverseMass, const TetherSet& tethers);
 
+/// Strain limiting: for each spring of the set in order, one whose length is above `stretch` times its rest
+/// length (stretch = 1 + the ceiling) is brought back to that length, its ends moved along it in proportion
+/// to their inverse masses (Provot 1995). One-sided: a spring at or under the ceiling, with both ends
+/// pinned, or of a NaN length is left alone. Each vector run's blocks of four are checked with vector loads
+/// (SSE2 on x86-64) and only a block with a spring beyond the ceiling goes through the scalar loop: bit for
+/// bit limitStretchScalar over the whole set.
+void limitStretch(float* px, float* py, float* pz, const float* inverseMass, const SpringSet& set,
+                  float stretch);
+
+/// limitStretch's scalar loop over springs [begin, end).
+void limitStretchScalar(float* px, float* py, float* pz, const float* inverseMass, const SpringSet& set,
+                        std::size_t begin, std::size_t end, float stretch);
+
 /// The linear bending hinges (Fabric.h's HingeSet) as XPBD constraints C = |d| - restBend, with d the
 /// hinge's curvature vector and the gradients w1 n, w2 n, -(w1 + w2) n at its first, second and middle
 /// particle (n = d / |d|, w1, w2 its arm weights), and the compliance 1 / (bendingRigidity areaOverLength2):

@@ -84,6 +84,21 @@ struct CAPE_CORE_API CapeSettings {
   /// full refinement for nothing: raise the limit or set 0.
   float strainLimit = 0.05f;
   int maxRefinement = 4;  ///< >= 1
+  /// Strain limiting (Provot 1995, "Deformation Constraints in a Mass-Spring Model to Describe Rigid Cloth
+  /// Behavior"): the most a structural spring may stretch, as a strain (0.1: 10 % beyond its rest length);
+  /// 0, the default, is off. In every constraint iteration, after the springs, strainCeilingPasses
+  /// Gauss-Seidel passes over the structural springs pull each one stretched beyond the ceiling back to it,
+  /// its ends moved in proportion to their inverse masses: a hard, one-sided constraint, so a spring under
+  /// the ceiling, compression, folds and gathers are untouched. One XPBD iteration per substep carries a
+  /// sudden load through a long cape too slowly, and a sprint's turn stretches single springs far beyond
+  /// the cloth's working strain; the ceiling stops them there, and the adaptive substepping above is needed
+  /// less often. The collisions and the self-contacts come after it in a substep and win where they
+  /// disagree. Off by default: the canonical cape of docs/SCENES.md, hung by its two corners, rests beyond a
+  /// few percent beside them and is measured without it; and a ceiling under the strain that a fold held by
+  /// self-contacts needs makes the two fight (docs/SOLVER.md, "Strain limiting", has the measurements).
+  /// Finite, 0..10. XPBD only.
+  float strainCeiling = 0.0f;
+  int strainCeilingPasses = 1;  ///< 1..64: passes over the structural springs per iteration.
   /// The numerical guard's reach (Cape::guard()), in rest diameters of the fabric beyond the farthest pin:
   /// a particle farther from the pins is lost and restored. > 0; the default is far beyond any stretch the
   /// springs allow, so only a runaway trips it.
