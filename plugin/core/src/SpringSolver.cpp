@@ -497,21 +497,29 @@ void solveTethers(float* px, float* py, float* pz, const float* inverseMass, con
 
 namespace {
 
+// The squared lengths of block [s, s + 4) of a run of layout L, as the scalar loops compute them
+// (dx dx + dy dy, plus dz dz).
+template <SpringLayout L>
+__m128 blockSquaredLengths(const float* px, const float* py, const float* pz, const SpringSet& set,
+                           std::uint32_t s) {
+  using In = Lanes<L>;
+  const std::uint32_t* p = set.first.data() + s;
+  const std::uint32_t* q = set.second.data() + s;
+  __m128 xi, xj, yi, yj, zi, zj;
+  In::load(px, p, q, xi, xj);
+  In::load(py, p, q, yi, yj);
+  In::load(pz, p, q, zi, zj);
+  const __m128 dx = _mm_sub_ps(xj, xi), dy = _mm_sub_ps(yj, yi), dz = _mm_sub_ps(zj, zi);
+  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+}
+
 // maxSquaredStretch over one vector run: four lanes of maxima (maxps(v, worst) keeps worst where v is NaN,
 // as std::max(worst, v) does).
 template <SpringLayout L>
 __m128 stretchBlocks(const float* px, const float* py, const float* pz, const SpringSet& set,
                      const SpringRun& run, __m128 worst) {
-  using In = Lanes<L>;
   for (std::uint32_t s = run.begin; s < run.end; s += 4) {
-    const std::uint32_t* p = set.first.data() + s;
-    const std::uint32_t* q = set.second.data() + s;
-    __m128 xi, xj, yi, yj, zi, zj;
-    In::load(px, p, q, xi, xj);
-    In::load(py, p, q, yi, yj);
-    In::load(pz, p, q, zi, zj);
-    const __m128 dx = _mm_sub_ps(xj, xi), dy = _mm_sub_ps(yj, yi), dz = _mm_sub_ps(zj, zi);
-    const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 len2 = blockSquaredLengths<L>(px, py, pz, set, s);
     const __m128 rest = _mm_loadu_ps(set.restLength.data() + s);
     worst = _mm_max_ps(_mm_div_ps(len2, _mm_mul_ps(rest, rest)), worst);
   }
@@ -544,17 +552,9 @@ namespace {
 template <SpringLayout L>
 void limitBlocks(float* px, float* py, float* pz, const float* inverseMass, const SpringSet& set,
                  const SpringRun& run, float stretch) {
-  using In = Lanes<L>;
   const __m128 factor = _mm_set1_ps(stretch);
   for (std::uint32_t s = run.begin; s < run.end; s += 4) {
-    const std::uint32_t* p = set.first.data() + s;
-    const std::uint32_t* q = set.second.data() + s;
-    __m128 xi, xj, yi, yj, zi, zj;
-    In::load(px, p, q, xi, xj);
-    In::load(py, p, q, yi, yj);
-    In::load(pz, p, q, zi, zj);
-    const __m128 dx = _mm_sub_ps(xj, xi), dy = _mm_sub_ps(yj, yi), dz = _mm_sub_ps(zj, zi);
-    const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 len2 = blockSquaredLengths<L>(px, py, pz, set, s);
     const __m128 maxLen = _mm_mul_ps(factor, _mm_loadu_ps(set.restLength.data() + s));
     if (_mm_movemask_ps(_mm_cmpgt_ps(len2, _mm_mul_ps(maxLen, maxLen))) != 0)
       limitStretchScalar(px, py, pz, inverseMass, set, s, s + 4, stretch);
