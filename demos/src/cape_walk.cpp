@@ -100,7 +100,8 @@ int main(int argc, char** argv) {
          "--max-refinement", maxRefinement,
          "strain-adaptive substepping's ceiling: while the cape's largest structural strain is above 5 %, "
          "up to N times the substeps (default: the solver's, 4; 1: never refine; a 64 x 64 cape in a "
-         "sprint needs 16 to stay within 10 %, docs/PERFORMANCE.md)")
+         "sprint needs 16 to stay within 10 %, or 8 with --strain-ceiling 0.08 --strain-passes 3, "
+         "docs/PERFORMANCE.md)")
       ->transform(strictInteger(1, 64));
   app.add_option("--strain-ceiling", strainCeiling,
                  "strain limiting: the most a structural spring may stretch, as a strain (0.1: 10 %), held "
