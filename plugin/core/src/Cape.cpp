@@ -829,8 +829,7 @@ void Cape::predict(float h) {
 void Cape::solveConstraints(float h) {
   // Tethers first (they fix the global stretch in one pass), then the springs, which are left with only
   // local corrections, then the strain ceiling over those still stretched beyond it, then the hinges and the
-  // self-contacts. Collisions come after, so the cape ends every substep outside
-  // the colliders.
+  // self-contacts. Collisions come after, so the cape ends every substep outside the colliders.
   // The multipliers start every substep at zero; with one iteration they are never read again, so none is
   // kept (SpringSolveArrays::lambda null).
   const bool bending = settings_.bendingRigidity > 0.0f && fabric_->hinges().size() > 0;
