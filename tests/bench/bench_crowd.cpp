@@ -150,11 +150,19 @@ struct Crowd {
   int frame = 0;
 };
 
-/// BM_CrowdFrame's body, with the group's hand-offs spinning up to `spin` us.
-void crowdFrame(benchmark::State& state, double spin) {
+/// BM_CrowdFrame's body, with the group's hand-offs spinning up to `spin` us, and each cape stepping once
+/// every `interval` internal steps (DetailLevel: the same fabric and substeps per frame).
+void crowdFrame(benchmark::State& state, double spin, int interval = 1) {
   const int count = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
   Crowd crowd(count, threads, state.range(2) != 0, spin);
+  for (auto& cape : crowd.capes) {
+    const cape::Status s = cape->setDetailLevel(cape::bullet::DetailLevel{interval, 0});
+    if (!s.ok()) {
+      state.SkipWithError(s.message().c_str());
+      return;
+    }
+  }
   for (int k = 0; k < 60; ++k) crowd.advance();  // a simulated second of warm-up
   std::vector<double> cape, advance, bullet, frame;
   for (auto _ : state) {
@@ -178,6 +186,12 @@ void crowdFrame(benchmark::State& state, double spin) {
 
 void BM_CrowdFrame(benchmark::State& state) {
   crowdFrame(state, 0.0);
+}
+
+// Every cape stepping once a frame, over the frame's four internal steps together, with the same fabric and
+// the same substeps a frame (DetailLevel{4, 0}): the capes' arrays are read once a frame, not four times.
+void BM_CrowdFrameOnceAFrame(benchmark::State& state) {
+  crowdFrame(state, 0.0, 4);
 }
 
 void BM_CrowdFrameSpin(benchmark::State& state) {
@@ -242,6 +256,9 @@ BENCHMARK(BM_CrowdFrameDetail)->Apply([](benchmark::internal::Benchmark* b) {
   b->Iterations(120)->Unit(benchmark::kMillisecond);
 });
 BENCHMARK(BM_CrowdFrame)->Apply([](benchmark::internal::Benchmark* b) { crowdArgs(b, {16, 100, 1000}); });
+BENCHMARK(BM_CrowdFrameOnceAFrame)->Apply([](benchmark::internal::Benchmark* b) {
+  crowdArgs(b, {16, 100, 1000});
+});
 BENCHMARK(BM_CrowdFrameSpin)->Apply([](benchmark::internal::Benchmark* b) {
   b->ArgNames({"K", "T", "P", "S"});
   for (int k : {16, 100})

@@ -537,6 +537,59 @@ std::size_t contactsBetweenSheets(int sheets, float gap, int moving, const Vec3&
   return between;
 }
 
+#if defined(__SSE2__)
+TEST(SelfCollision, TheSolvesFourWideApartTestsAreTheScalarOnesLaneByLane) {
+  // SelfCollision::solve passes over apart contacts four at a time (detail::apartLanes): each lane must
+  // answer what the scalar test (detail::contactApart) answers, bit for bit, or the solve would differ from
+  // a loop over the contacts one by one. Particles near and far, on either side or none, triangles of every
+  // shape (slivers, collapsed ones), coordinates far from the origin, and some not finite.
+  std::mt19937 rng(20261207);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f), fraction(0.0f, 1.0f);
+  std::uniform_int_distribution<int> sideOf(-1, 1);
+  constexpr std::uint32_t kBlocks = 50000;
+  // Every contact its own particle and triangle (particle 4k, corners 4k+1..4k+3) so that the lanes gather
+  // from anywhere in the array.
+  Points x(16 * kBlocks, 3);
+  std::vector<std::uint32_t> triangles;
+  std::vector<Cape::SelfContact> contacts;
+  for (std::uint32_t i = 0; i < 4 * kBlocks; ++i) {
+    const float scale = std::pow(10.0f, 3.0f * fraction(rng) - 3.0f);
+    const Vec3 origin = Vec3(unit(rng), unit(rng), unit(rng)) * (i % 5 == 0 ? 1e5f : 10.0f) * fraction(rng);
+    Vec3 corner[3];
+    for (Vec3& k : corner) k = origin + scale * Vec3(unit(rng), unit(rng), unit(rng));
+    if (i % 7 == 0) corner[2] = corner[0] + fraction(rng) * (corner[1] - corner[0]);  // on a line
+    if (i % 11 == 0) corner[1] = corner[0];                                           // collapsed
+    const Vec3 p = origin + (i % 3 == 0 ? 6.0f : 1.5f) * scale * Vec3(unit(rng), unit(rng), unit(rng));
+    const std::uint32_t base = 4 * i;
+    x.row(base) = p.transpose();
+    for (int k = 0; k < 3; ++k) x.row(base + 1 + static_cast<std::uint32_t>(k)) = corner[k].transpose();
+    if (i % 97 == 0)
+      x(base + 1 + i % 3, static_cast<Eigen::Index>(i % 3)) = std::numeric_limits<float>::quiet_NaN();
+    triangles.insert(triangles.end(), {base + 1, base + 2, base + 3});
+    contacts.push_back({base, i, static_cast<float>(sideOf(rng))});
+  }
+  int apart = 0, near = 0;
+  for (std::uint32_t block = 0; block < kBlocks; ++block) {
+    // A thickness per block (the solve's is the same for all of its contacts).
+    const float thickness = std::pow(10.0f, 3.0f * fraction(rng) - 3.5f);
+    const int lanes = detail::apartLanes(x, triangles, &contacts[4 * block], thickness);
+    for (int lane = 0; lane < 4; ++lane) {
+      const Cape::SelfContact& k = contacts[4 * block + static_cast<std::uint32_t>(lane)];
+      const auto at = [&](std::uint32_t i) -> Vec3 { return x.row(i).transpose(); };
+      const std::uint32_t* t = &triangles[3 * k.triangle];
+      const bool scalar =
+          detail::contactApart(at(k.particle), at(t[0]), at(t[1]), at(t[2]), k.side, thickness);
+      ASSERT_EQ((lanes >> lane & 1) != 0, scalar)
+          << "contact " << 4 * block + static_cast<std::uint32_t>(lane);
+      (scalar ? apart : near) += 1;
+    }
+  }
+  // Both answers are common, so that a lane stuck at either would fail above.
+  EXPECT_GT(apart, static_cast<int>(kBlocks / 2)) << apart;
+  EXPECT_GT(near, static_cast<int>(kBlocks / 2)) << near;
+}
+#endif
+
 TEST(SelfCollision, ASearchKeepsThePairsThatApproachAndDropsThoseThatSlidePastOrPart) {
   // The reach: the thickness (0.35 of the 0.1 m spacing) and the slack (a quarter of it), 6 cm. A sheet
   // 15 cm above another coming down at 6 m/s (10 cm in the 1/60 s window) comes within it: its pairs are

@@ -168,9 +168,11 @@ bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c
 // the weights are well conditioned. Most self-contacts are such pairs at every substep: a fast cape's search
 // reaches the 2-ring of a particle in its own sheet, more than a spacing away and never within the thickness
 // (99.5 % of the solve's visits in the 20 x 20 sprint-turn).
+// besideAndApart's bound on the most negative weight, for kFaceMargin 1/4 (apartLanes reads it too).
+constexpr float kBesideBeyond = -0.27f;
+
 bool besideAndApart(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float thickness) {
   static_assert(kFaceMargin == 0.25f, "the bound below is for a margin of 1/4");
-  constexpr float kBeyond = -0.27f;
   const Vec3 v0 = b - a, v1 = c - a, v2 = p - a;
   const float d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
   const float den = d00 * d11 - d01 * d01;
@@ -183,13 +185,24 @@ bool besideAndApart(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, 
   float dk = db, edge2 = d11;         // w_b's opposite edge: ac
   if (dc < dk) dk = dc, edge2 = d00;  // w_c's: ab
   if (da < dk) dk = da, edge2 = (c - b).squaredNorm();
-  if (!(dk < kBeyond * den)) return false;
+  if (!(dk < kBesideBeyond * den)) return false;
   // Squared distance from the edge's line in the plane, (w_k |n| / |edge|)^2 = dk^2 / (den edge2), plus the
   // squared distance from the plane, (n . v2)^2 / den; against thickness^2 (and 0.2 % for rounding), all
   // times den edge2.
   const float normal = v0.cross(v1).dot(v2);
   const float reach2 = thickness * thickness * 1.002f;
   return dk * dk + normal * normal * edge2 >= reach2 * den * edge2;
+}
+
+bool contactApart(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float side, float thickness) {
+  if (side != 0.0f) {
+    // On its side of the plane and at least the thickness from it, so farther than that from the triangle
+    // too: told without the nearest point.
+    const Vec3 n = (b - a).cross(c - a);
+    const float d = side * n.dot(p - a);
+    if (d >= 0.0f && d * d >= thickness * thickness * n.squaredNorm()) return true;
+  }
+  return besideAndApart(p, a, b, c, thickness);
 }
 
 bool closestOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, float& s, float& t,
@@ -741,62 +754,157 @@ void SelfCollision::scanBucket(std::uint32_t q, const Vec3& p, const float* qlo,
   }
 }
 
+#if defined(__SSE2__)
+
+namespace {
+
+// Four 3-vectors, one per lane, and the operations of Eigen's fixed-size ones in the same order (its dot
+// product is a0 b0 + (a1 b1 + a2 b2), its squared norm likewise; the core is built without contraction into
+// fused multiply-adds), so that each lane's figures are the scalar ones bit for bit.
+struct Lanes3 {
+  __m128 x, y, z;
+};
+inline Lanes3 minus(const Lanes3& a, const Lanes3& b) {
+  return {_mm_sub_ps(a.x, b.x), _mm_sub_ps(a.y, b.y), _mm_sub_ps(a.z, b.z)};
+}
+inline __m128 dot(const Lanes3& a, const Lanes3& b) {
+  return _mm_add_ps(_mm_mul_ps(a.x, b.x), _mm_add_ps(_mm_mul_ps(a.y, b.y), _mm_mul_ps(a.z, b.z)));
+}
+inline Lanes3 cross(const Lanes3& a, const Lanes3& b) {
+  return {_mm_sub_ps(_mm_mul_ps(a.y, b.z), _mm_mul_ps(a.z, b.y)),
+          _mm_sub_ps(_mm_mul_ps(a.z, b.x), _mm_mul_ps(a.x, b.z)),
+          _mm_sub_ps(_mm_mul_ps(a.x, b.y), _mm_mul_ps(a.y, b.x))};
+}
+inline __m128 select(__m128 mask, __m128 yes, __m128 no) {
+  return _mm_or_ps(_mm_and_ps(mask, yes), _mm_andnot_ps(mask, no));
+}
+
+}  // namespace
+
+int apartLanes(const Points& x, const std::vector<std::uint32_t>& tri, const Cape::SelfContact* k,
+               float thickness) {
+  // contactApart four contacts at a time, line for line.
+  const float *px = x.col(0).data(), *py = x.col(1).data(), *pz = x.col(2).data();
+  const auto gather = [&](std::uint32_t i0, std::uint32_t i1, std::uint32_t i2, std::uint32_t i3) {
+    return Lanes3{_mm_setr_ps(px[i0], px[i1], px[i2], px[i3]), _mm_setr_ps(py[i0], py[i1], py[i2], py[i3]),
+                  _mm_setr_ps(pz[i0], pz[i1], pz[i2], pz[i3])};
+  };
+  const auto corner = [&](int c) {
+    return gather(tri[3 * k[0].triangle + c], tri[3 * k[1].triangle + c], tri[3 * k[2].triangle + c],
+                  tri[3 * k[3].triangle + c]);
+  };
+  const Lanes3 p = gather(k[0].particle, k[1].particle, k[2].particle, k[3].particle);
+  const Lanes3 a = corner(0), b = corner(1), c = corner(2);
+  const __m128 side = _mm_setr_ps(k[0].side, k[1].side, k[2].side, k[3].side);
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 t2 = _mm_set1_ps(thickness * thickness);
+  const Lanes3 v0 = minus(b, a), v1 = minus(c, a), v2 = minus(p, a);
+  const Lanes3 n = cross(v0, v1);
+  // On its side, beyond the thickness (only for a contact with a side).
+  const __m128 d = _mm_mul_ps(side, dot(n, v2));
+  const __m128 onSide = _mm_and_ps(
+      _mm_cmpneq_ps(side, zero),
+      _mm_and_ps(_mm_cmpge_ps(d, zero), _mm_cmpge_ps(_mm_mul_ps(d, d), _mm_mul_ps(t2, dot(n, n)))));
+  // Beside and apart.
+  const __m128 d00 = dot(v0, v0), d01 = dot(v0, v1), d11 = dot(v1, v1), d20 = dot(v2, v0), d21 = dot(v2, v1);
+  const __m128 den = _mm_sub_ps(_mm_mul_ps(d00, d11), _mm_mul_ps(d01, d01));
+  __m128 beside = _mm_and_ps(_mm_cmpge_ps(den, _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(0.01f), d00), d11)),
+                             _mm_cmpgt_ps(den, _mm_set1_ps(1e-20f)));
+  const __m128 db = _mm_sub_ps(_mm_mul_ps(d11, d20), _mm_mul_ps(d01, d21));
+  const __m128 dc = _mm_sub_ps(_mm_mul_ps(d00, d21), _mm_mul_ps(d01, d20));
+  const __m128 da = _mm_sub_ps(_mm_sub_ps(den, db), dc);
+  const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  const __m128 bound = _mm_mul_ps(_mm_set1_ps(100.0f), den);
+  beside = _mm_and_ps(beside, _mm_and_ps(_mm_cmple_ps(_mm_and_ps(db, absMask), bound),
+                                         _mm_cmple_ps(_mm_and_ps(dc, absMask), bound)));
+  __m128 dk = db, edge2 = d11;
+  const __m128 takeC = _mm_cmplt_ps(dc, dk);
+  dk = select(takeC, dc, dk);
+  edge2 = select(takeC, d00, edge2);
+  const Lanes3 cb = minus(c, b);
+  const __m128 takeA = _mm_cmplt_ps(da, dk);
+  dk = select(takeA, da, dk);
+  edge2 = select(takeA, dot(cb, cb), edge2);
+  beside = _mm_and_ps(beside, _mm_cmplt_ps(dk, _mm_mul_ps(_mm_set1_ps(kBesideBeyond), den)));
+  const __m128 normal = dot(n, v2);
+  const __m128 reach2 = _mm_set1_ps(thickness * thickness * 1.002f);
+  beside = _mm_and_ps(
+      beside, _mm_cmpge_ps(_mm_add_ps(_mm_mul_ps(dk, dk), _mm_mul_ps(_mm_mul_ps(normal, normal), edge2)),
+                           _mm_mul_ps(_mm_mul_ps(reach2, den), edge2)));
+  return _mm_movemask_ps(_mm_or_ps(onSide, beside));
+}
+
+#endif
+
+CAPE_ALWAYS_INLINE inline void SelfCollision::solveContact(Points& x, const float* w, float thickness,
+                                                           float maxCrossing, Cape::SelfContact& k) {
+  const std::vector<std::uint32_t>& tri = fabric_.triangles();
+  const std::uint32_t ia = tri[3 * k.triangle], ib = tri[3 * k.triangle + 1], ic = tri[3 * k.triangle + 2];
+  const Vec3 p = at(x, k.particle), a = at(x, ia), b = at(x, ib), c = at(x, ic);
+  if (contactApart(p, a, b, c, k.side, thickness)) return;  // most listed pairs are apart
+  const TriangleNearest bary = nearestOnTriangle(p, a, b, c);
+  Vec3 normal;
+  float distance;
+  float wa, wb, wc;
+  if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc)) {
+    // Over the (grown) face: keep to the side the particle started the step on, or first came over it from.
+    Vec3 faceNormal = (b - a).cross(c - a);
+    const float len = faceNormal.norm();
+    if (!(len > 0.0f)) return;
+    faceNormal /= len;
+    if (k.side == 0.0f) k.side = faceNormal.dot(p - a) >= 0.0f ? 1.0f : -1.0f;
+    normal = k.side * faceNormal;
+    distance = normal.dot(p - a);  // negative: it has crossed, and is brought back
+    // Far on the other side is not a crossing within this step (the region over a face reaches out along
+    // its normal without end, and a triangle that turns over carries its side with it): pulling such a
+    // particle back through the cloth would throw it across the cape, so the pair is let go.
+    if (distance < -maxCrossing) return;
+    // The correction goes to the corners by the weights of the nearest point of the real triangle.
+  } else {
+    // Beside an edge or a corner: a plain distance, no side to keep.
+    const Vec3 d = p - (bary.wa * a + bary.wb * b + bary.wc * c);
+    distance = d.norm();
+    if (!(distance > 1e-9f)) return;
+    normal = d / distance;
+  }
+  if (distance >= thickness) return;
+  // PBD point-triangle constraint C = n . (p - sum w_k x_k) - thickness >= 0, gradients n and -w_k n.
+  const float invP = w[k.particle], invA = w[ia], invB = w[ib], invC = w[ic];
+  // A corner k moves by invK w_k violation / denominator: the denominator is kept at least invK w_k /
+  // kMaxCornerAmplification for every corner (kMaxCornerAmplification's comment); with equal masses (the
+  // grid's) it is left as it is whenever the particle or all three corners can move.
+  const float denominator =
+      std::max(invP + bary.wa * bary.wa * invA + bary.wb * bary.wb * invB + bary.wc * bary.wc * invC,
+               std::max({invA * bary.wa, invB * bary.wb, invC * bary.wc}) / kMaxCornerAmplification);
+  if (!(denominator > 0.0f)) return;
+  const Vec3 step = ((thickness - distance) / denominator) * normal;
+  x.row(k.particle) += invP * step.transpose();
+  x.row(ia) -= (invA * bary.wa) * step.transpose();
+  x.row(ib) -= (invB * bary.wb) * step.transpose();
+  x.row(ic) -= (invC * bary.wc) * step.transpose();
+}
+
 void SelfCollision::solve(Points& x, const float* w, float thickness) {
   // The deepest a particle can have crossed within one step and still be brought back: half the spacing.
   const float maxCrossing = 0.5f * fabric_.meanSpacing();
-  const std::vector<std::uint32_t>& tri = fabric_.triangles();
-  for (Cape::SelfContact& k : contacts_) {
-    const std::uint32_t ia = tri[3 * k.triangle], ib = tri[3 * k.triangle + 1], ic = tri[3 * k.triangle + 2];
-    const Vec3 p = at(x, k.particle), a = at(x, ia), b = at(x, ib), c = at(x, ic);
-    if (k.side != 0.0f) {
-      // Most listed pairs are apart: on their side of the plane and at least the thickness from it, so
-      // farther than that from the triangle too. Rejected here without the nearest point.
-      const Vec3 n = (b - a).cross(c - a);
-      const float d = k.side * n.dot(p - a);
-      if (d >= 0.0f && d * d >= thickness * thickness * n.squaredNorm()) continue;
+  // In order (Gauss-Seidel). Most listed pairs are apart, and solveContact passes them over: four at a time
+  // their tests say so (apartLanes, the same figures), and the first of the four that is not apart is solved
+  // on its own, the next four starting after it, so that each contact's tests read the positions every
+  // contact before it left, as in a loop over them one by one.
+  std::size_t next = 0;
+#if defined(__SSE2__)
+  while (next + 4 <= contacts_.size()) {
+    const int apart = apartLanes(x, fabric_.triangles(), &contacts_[next], thickness);
+    if (apart == 0xF) {
+      next += 4;
+      continue;
     }
-    if (besideAndApart(p, a, b, c, thickness)) continue;
-    const TriangleNearest bary = nearestOnTriangle(p, a, b, c);
-    Vec3 normal;
-    float distance;
-    float wa, wb, wc;
-    if (planeBarycentric(p, a, b, c, wa, wb, wc) && overFace(wa, wb, wc)) {
-      // Over the (grown) face: keep to the side the particle started the step on, or first came over it from.
-      Vec3 faceNormal = (b - a).cross(c - a);
-      const float len = faceNormal.norm();
-      if (!(len > 0.0f)) continue;
-      faceNormal /= len;
-      if (k.side == 0.0f) k.side = faceNormal.dot(p - a) >= 0.0f ? 1.0f : -1.0f;
-      normal = k.side * faceNormal;
-      distance = normal.dot(p - a);  // negative: it has crossed, and is brought back
-      // Far on the other side is not a crossing within this step (the region over a face reaches out along
-      // its normal without end, and a triangle that turns over carries its side with it): pulling such a
-      // particle back through the cloth would throw it across the cape, so the pair is let go.
-      if (distance < -maxCrossing) continue;
-      // The correction goes to the corners by the weights of the nearest point of the real triangle.
-    } else {
-      // Beside an edge or a corner: a plain distance, no side to keep.
-      const Vec3 d = p - (bary.wa * a + bary.wb * b + bary.wc * c);
-      distance = d.norm();
-      if (!(distance > 1e-9f)) continue;
-      normal = d / distance;
-    }
-    if (distance >= thickness) continue;
-    // PBD point-triangle constraint C = n . (p - sum w_k x_k) - thickness >= 0, gradients n and -w_k n.
-    const float invP = w[k.particle], invA = w[ia], invB = w[ib], invC = w[ic];
-    // A corner k moves by invK w_k violation / denominator: the denominator is kept at least invK w_k /
-    // kMaxCornerAmplification for every corner (kMaxCornerAmplification's comment); with equal masses (the
-    // grid's) it is left as it is whenever the particle or all three corners can move.
-    const float denominator =
-        std::max(invP + bary.wa * bary.wa * invA + bary.wb * bary.wb * invB + bary.wc * bary.wc * invC,
-                 std::max({invA * bary.wa, invB * bary.wb, invC * bary.wc}) / kMaxCornerAmplification);
-    if (!(denominator > 0.0f)) continue;
-    const Vec3 step = ((thickness - distance) / denominator) * normal;
-    x.row(k.particle) += invP * step.transpose();
-    x.row(ia) -= (invA * bary.wa) * step.transpose();
-    x.row(ib) -= (invB * bary.wb) * step.transpose();
-    x.row(ic) -= (invC * bary.wc) * step.transpose();
+    next += static_cast<std::size_t>(__builtin_ctz(static_cast<unsigned>(~apart)));
+    solveContact(x, w, thickness, maxCrossing, contacts_[next]);
+    ++next;
   }
+#endif
+  for (; next < contacts_.size(); ++next) solveContact(x, w, thickness, maxCrossing, contacts_[next]);
   if (!edgeContacts_.empty()) solveEdges(x, w, thickness, maxCrossing);
 }
 

@@ -24,6 +24,18 @@ inline constexpr float kFaceMargin = 0.25f;
 /// decides.
 bool besideAndApart(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float thickness);
 
+/// Whether SelfCollision::solve passes over the contact of particle p with triangle (a, b, c), noted on
+/// `side` (+1, -1, or 0 for none yet): on that side of the plane and at least the thickness from it, or
+/// besideAndApart.
+bool contactApart(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float side, float thickness);
+
+#if defined(__SSE2__)
+/// contactApart for four contacts k[0..3] at once, at positions x (`triangles`: Fabric::triangles()): bit i
+/// set if contact k[i] is apart. The same operations in the same order in every lane, so the same answer.
+int apartLanes(const Points& x, const std::vector<std::uint32_t>& triangles, const Cape::SelfContact* k,
+               float thickness);
+#endif
+
 /// The closest points of segments p0-p1 and q0-q1: p0 + s (p1 - p0) and q0 + t (q1 - q0), s and t in [0, 1].
 /// `interior` when both lie strictly inside their segments and the segments are not parallel: the points are
 /// then unique and their difference is along (p1 - p0) x (q1 - q0). false if either segment is degenerate.
@@ -104,6 +116,9 @@ class SelfCollision {
   /// Edge pair i that the cheap test could not pass over: the exact test, and the contact if within reach.
   void considerEdgePair(std::size_t i, const Points& x);
   void solveEdges(Points& x, const float* w, float thickness, float maxCrossing);
+  /// One particle-triangle contact of solve(): passed over if apart, else kept to its side, the thickness
+  /// away.
+  void solveContact(Points& x, const float* w, float thickness, float maxCrossing, Cape::SelfContact& k);
 
   const Fabric& fabric_;
   std::vector<Cape::SelfContact> contacts_;
