@@ -160,6 +160,10 @@ bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c
   return true;
 }
 
+// besideAndApart's bound on the most negative weight, kFaceMargin's -0.25 and room for rounding (apartLanes
+// reads it too).
+constexpr float kBesideBeyond = -0.27f;
+
 // With planeBarycentric's weights times its denominator (den = |n|^2, no division): a weight w_k below
 // -0.27 puts p's projection beyond the grown face (kFaceMargin, -0.25, with room for the rounding of both
 // computations), and beyond the line of the edge opposite corner k by -w_k times the altitude from k,
@@ -168,9 +172,6 @@ bool planeBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c
 // the weights are well conditioned. Most self-contacts are such pairs at every substep: a fast cape's search
 // reaches the 2-ring of a particle in its own sheet, more than a spacing away and never within the thickness
 // (99.5 % of the solve's visits in the 20 x 20 sprint-turn).
-// besideAndApart's bound on the most negative weight, for kFaceMargin 1/4 (apartLanes reads it too).
-constexpr float kBesideBeyond = -0.27f;
-
 bool besideAndApart(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, float thickness) {
   static_assert(kFaceMargin == 0.25f, "the bound below is for a margin of 1/4");
   const Vec3 v0 = b - a, v1 = c - a, v2 = p - a;
