@@ -785,5 +785,157 @@ TEST(SelfCollision, AMeshWhoseThicknessReachesEveryTriangleKeepsTheBoundPerParti
   }
 }
 
+// The flat proof's rest gaps (Fabric::FlatProof), against every particle and every triangle: grids square and
+// long, coarse and fine, with and without bend springs. Each tier is the least rest distance of the pairs of
+// that many king's moves, the pairs it leaves out are at least `beyond` apart, and every pair the search can
+// make is in a tier or beyond.
+TEST(SelfCollision, TheFlatProofsRestGapsAreTheLeastOverEveryPair) {
+  struct Size {
+    int columns, rows;
+    float width, height;
+  };
+  for (const Size& g : {Size{20, 20, 0.6f, 1.0f}, Size{7, 3, 0.3f, 0.05f}, Size{3, 11, 0.02f, 0.9f},
+                        Size{12, 9, 1.0f, 1.0f}, Size{2, 2, 0.1f, 0.1f}}) {
+    const FabricPtr fabric = test::makeGrid(g.columns, g.rows, g.width, g.height);
+    ASSERT_TRUE(fabric);
+    const Fabric::FlatProof* proof = fabric->flatProof();
+    ASSERT_NE(proof, nullptr);
+    const Points& rest = fabric->restPositions();
+    const auto at2 = [&rest](std::uint32_t i) { return Eigen::Vector2d(rest(i, 0), rest(i, 1)); };
+    std::vector<double> tier(proof->particleTriangle.size(), std::numeric_limits<double>::infinity());
+    const std::vector<std::uint32_t>& tri = fabric->triangles();
+    for (std::uint32_t q = 0; q < fabric->particleCount(); ++q)
+      for (std::size_t t = 0; t < fabric->triangleCount(); ++t) {
+        const std::uint32_t* local = fabric->triangleLocal()[t].v;
+        if (std::find(local, local + 6, q) != local + 6) continue;
+        // The distance to the triangle: 0 over it, else to the nearest of its sides.
+        const Eigen::Vector2d p = at2(q), a = at2(tri[3 * t]), b = at2(tri[3 * t + 1]),
+                              c = at2(tri[3 * t + 2]);
+        const Eigen::Vector2d corners[3] = {a, b, c};
+        double d = std::numeric_limits<double>::infinity();
+        bool inside = true;
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector2d& e0 = corners[k];
+          const Eigen::Vector2d& e1 = corners[(k + 1) % 3];
+          const Eigen::Vector2d side = e1 - e0;
+          inside = inside && side.x() * (p - e0).y() - side.y() * (p - e0).x() >= 0.0;  // counter-clockwise
+          const double along = std::clamp((p - e0).dot(side) / side.squaredNorm(), 0.0, 1.0);
+          d = std::min(d, (p - (e0 + along * side)).norm());
+        }
+        if (inside) d = 0.0;
+        int hops = 0;
+        for (int k = 0; k < 3; ++k) {
+          const int v = static_cast<int>(tri[3 * t + static_cast<std::size_t>(k)]);
+          hops = std::max({hops, std::abs(v / g.columns - static_cast<int>(q) / g.columns),
+                           std::abs(v % g.columns - static_cast<int>(q) % g.columns)});
+        }
+        // Sound: the pair is at least its tier's gap apart, or `beyond`.
+        const double gap = static_cast<std::size_t>(hops) < tier.size()
+                               ? static_cast<double>(proof->particleTriangle[static_cast<std::size_t>(hops)])
+                               : std::numeric_limits<double>::infinity();
+        EXPECT_TRUE(d >= gap - 1e-6 || d >= proof->beyond - 1e-6)
+            << g.columns << " x " << g.rows << ": particle " << q << ", triangle " << t << ", " << hops
+            << " moves";
+        if (hops <= Fabric::kProofReach)
+          tier[static_cast<std::size_t>(hops)] = std::min(tier[static_cast<std::size_t>(hops)], d);
+      }
+    // Tight: the tiers of up to kProofReach moves take in every such pair, and are their least distance.
+    for (int h = 0; h <= Fabric::kProofReach; ++h) {
+      const auto k = static_cast<std::size_t>(h);
+      if (std::isfinite(tier[k])) {
+        EXPECT_NEAR(proof->particleTriangle[k], tier[k], 1e-6)
+            << g.columns << " x " << g.rows << " tier " << h;
+      } else {
+        EXPECT_EQ(proof->particleTriangle[k], std::numeric_limits<float>::infinity()) << h;
+      }
+    }
+  }
+}
+/// The cape of a scene's frames, searched with and without the flat proof (SelfCollision::provenApart):
+/// both must find the same contacts in the same order. Returns how many searches the proof passed over.
+std::uint64_t searchBothWays(SceneKind kind, int n, PinLayout layout, int frames, std::uint64_t& searches) {
+  CapeSettings s;
+  s.selfCollision = true;
+  SimpleScene scene(kind, n, layout, s);
+  EXPECT_TRUE(scene.status().ok());
+  std::uint64_t proven = 0;
+  for (int f = 0; f < frames; ++f) {
+    scene.advanceFrame();
+    const Cape& cape = scene.cape();
+    const CapeSettings& settings = cape.settings();
+    const Eigen::VectorXf free = (cape.state().inverseMasses.array() > 0.0f).cast<float>();
+    detail::SelfCollision with(cape.fabric()), without(cape.fabric());
+    without.setFlatProof(false);
+    for (float window : {1.0f / 60.0f, 1.0f / 240.0f}) {
+      with.searchFor(cape.state(), free, settings, window);
+      without.searchFor(cape.state(), free, settings, window);
+      ++searches;
+      const auto& a = with.contacts();
+      const auto& b = without.contacts();
+      EXPECT_EQ(a.size(), b.size()) << toString(kind) << " " << n << " frame " << f;
+      for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i)
+        EXPECT_TRUE(a[i].particle == b[i].particle && a[i].triangle == b[i].triangle &&
+                    a[i].side == b[i].side)
+            << toString(kind) << " " << n << " frame " << f << " contact " << i;
+      const auto& ea = with.edgeContacts();
+      const auto& eb = without.edgeContacts();
+      EXPECT_EQ(ea.size(), eb.size()) << toString(kind) << " " << n << " frame " << f;
+      for (std::size_t i = 0; i < std::min(ea.size(), eb.size()); ++i)
+        EXPECT_TRUE(ea[i].pair == eb[i].pair && ea[i].side == eb[i].side)
+            << toString(kind) << " " << n << " frame " << f << " edge contact " << i;
+    }
+    proven = with.searchesProvenApart() + proven;
+  }
+  return proven;
+}
+
+// The flat proof passes over a search only where the search would have found nothing: every search of the
+// walk, the sprint-turn and the wind, corners and gathered, 20 x 20 and 32 x 32, with the proof and without,
+// finds the same contacts. And it does pass over most of a calm walk's searches.
+TEST(SelfCollision, TheFlatProofPassesOverOnlySearchesThatFindNothing) {
+  std::uint64_t searches = 0, proven = 0;
+  for (const SceneKind kind : {SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind})
+    for (const PinLayout layout : {PinLayout::Corners, PinLayout::Gathered})
+      for (const int n : {20, 32}) proven += searchBothWays(kind, n, layout, 100, searches);
+  std::uint64_t walkSearches = 0;
+  const std::uint64_t walkProven = searchBothWays(SceneKind::Walk, 20, PinLayout::Corners, 200, walkSearches);
+  std::printf("flat proof: %llu of %llu searches passed over; the 20 x 20 walk %llu of %llu\n",
+              static_cast<unsigned long long>(proven), static_cast<unsigned long long>(searches),
+              static_cast<unsigned long long>(walkProven), static_cast<unsigned long long>(walkSearches));
+  EXPECT_GT(walkProven, walkSearches / 4);
+}
+
+/// A fabric at rest: its rest positions, still, every particle free.
+CapeState restStateOf(const Fabric& fabric) {
+  CapeState state;
+  state.positions = fabric.restPositions();
+  state.velocities = Points::Zero(state.positions.rows(), 3);
+  state.inverseMasses = Eigen::VectorXf::Ones(state.positions.rows());
+  return state;
+}
+
+// A sheet folded over itself is not flat: the proof cannot pass over its search, which finds contacts.
+TEST(SelfCollision, TheFlatProofDoesNotPassOverAFoldedSheet) {
+  const FabricPtr fabric = test::makeGrid(12, 12, 0.5f, 0.5f);
+  ASSERT_TRUE(fabric);
+  CapeState state = restStateOf(*fabric);
+  // Fold the lower half back under the upper, 1.5 cm below it.
+  for (Eigen::Index i = 0; i < state.positions.rows(); ++i) {
+    const float y = state.positions(i, 1);
+    if (y < -0.25f) state.positions.row(i) << state.positions(i, 0), -0.5f - y, -0.015f;
+  }
+  CapeSettings settings = test::quietSettings();
+  settings.selfCollision = true;
+  detail::SelfCollision self(*fabric);
+  self.searchFor(state, Eigen::VectorXf::Ones(state.positions.rows()), settings, 1.0f / 60.0f);
+  EXPECT_EQ(self.searchesProvenApart(), 0u);
+  EXPECT_GT(self.contacts().size(), 0u);
+  // The same sheet unfolded is proven apart.
+  detail::SelfCollision flat(*fabric);
+  flat.searchFor(restStateOf(*fabric), Eigen::VectorXf::Ones(state.positions.rows()), settings, 1.0f / 60.0f);
+  EXPECT_EQ(flat.searchesProvenApart(), 1u);
+  EXPECT_TRUE(flat.contacts().empty());
+}
+
 }  // namespace
 }  // namespace cape

@@ -252,6 +252,10 @@ std::uint64_t Cape::selfContactSearches() const {
   return work_ ? work_->self.searches() : 0;
 }
 
+std::uint64_t Cape::selfContactSearchesProvenApart() const {
+  return work_ ? work_->self.searchesProvenApart() : 0;
+}
+
 Status Cape::setGravity(const Vec3& gravity) {
   if (!gravity.allFinite()) return Status::error("Cape::setGravity: gravity must be finite");
   if (gravity != settings_.gravity) wake();

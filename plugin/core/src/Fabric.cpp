@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <numeric>
@@ -425,6 +426,7 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
         structural.size() > 0 ? static_cast<float>(sum / static_cast<double>(structural.size())) : 0.01f;
   }
   buildTriangleTables();
+  if (gridColumns_ > 0) buildFlatProof();
   buildComponents();
   buildHinges();
   return buildTethers(anchors, tethersPerParticle, tetherScale);
@@ -597,6 +599,102 @@ Status Fabric::buildTethers(const std::vector<std::uint32_t>& anchors, int tethe
     }
   }
   return Status::success();
+}
+
+namespace {
+
+/// The distance from point p to segment a-b in the plane.
+double segmentDistance2d(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (p - (a + t * ab)).norm();
+}
+
+/// The distance from point p to triangle (a, b, c) in the plane: 0 inside or on it.
+double triangleDistance2d(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                          const Eigen::Vector2d& c) {
+  const auto side = [](const Eigen::Vector2d& o, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
+    return (q.x() - o.x()) * (r.y() - o.y()) - (q.y() - o.y()) * (r.x() - o.x());
+  };
+  const double s0 = side(a, b, p), s1 = side(b, c, p), s2 = side(c, a, p);
+  if ((s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0)) return 0.0;
+  return std::min({segmentDistance2d(p, a, b), segmentDistance2d(p, b, c), segmentDistance2d(p, c, a)});
+}
+
+}  // namespace
+
+void Fabric::buildFlatProof() {
+  // Per triangle, the inverse of its rest edge matrix; and the least rest distance from a particle to a
+  // triangle not local to it, found among the triangles of the cells around the particle: a triangle of a
+  // cell three or more rows or columns away is at least three spacings away, so the search goes no farther
+  // and the figure is capped there.
+  const int nc = gridColumns_, nr = gridRows_;
+  const std::size_t triangles = triangleCount();
+  const auto rest = [this](std::uint32_t i) {
+    return Eigen::Vector2d(restPositions_(i, 0), restPositions_(i, 1));
+  };
+  flatProof_.restInverse.assign(4 * triangles, 0.0f);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const Eigen::Vector2d a = rest(triangles_[3 * t]), e1 = rest(triangles_[3 * t + 1]) - a,
+                          e2 = rest(triangles_[3 * t + 2]) - a;
+    Eigen::Matrix2d m;
+    m << e1, e2;
+    const Eigen::Matrix2d inverse = m.inverse();  // a grid's rest triangles are never degenerate
+    for (int k = 0; k < 4; ++k)
+      flatProof_.restInverse[4 * t + static_cast<std::size_t>(k)] = static_cast<float>(inverse(k % 2, k / 2));
+  }
+  // The triangles of each cell (a triangle's cell: its corners' least row and column).
+  const auto cellOf = [nc](std::uint32_t i, std::uint32_t j, std::uint32_t k) {
+    return std::make_pair(std::min({i, j, k}) / static_cast<std::uint32_t>(nc),
+                          std::min({i % nc, j % nc, k % nc}));
+  };
+  const std::size_t cells = static_cast<std::size_t>(nr - 1) * static_cast<std::size_t>(nc - 1);
+  std::vector<std::uint32_t> cellStart(cells + 1, 0u), cellTriangles(triangles);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const auto [r, c] = cellOf(triangles_[3 * t], triangles_[3 * t + 1], triangles_[3 * t + 2]);
+    ++cellStart[r * static_cast<std::size_t>(nc - 1) + c + 1];
+  }
+  std::partial_sum(cellStart.begin(), cellStart.end(), cellStart.begin());
+  {
+    std::vector<std::uint32_t> cursor(cellStart.begin(), cellStart.end() - 1);
+    for (std::size_t t = 0; t < triangles; ++t) {
+      const auto [r, c] = cellOf(triangles_[3 * t], triangles_[3 * t + 1], triangles_[3 * t + 2]);
+      cellTriangles[cursor[r * static_cast<std::size_t>(nc - 1) + c]++] = static_cast<std::uint32_t>(t);
+    }
+  }
+  constexpr int kReach = kProofReach;
+  const double dx = static_cast<double>(gridDesc_.width) / (nc - 1),
+               dy = static_cast<double>(gridDesc_.height) / (nr - 1);
+  std::vector<double> least(kReach + 3, std::numeric_limits<double>::infinity());
+  const auto king = [nc](std::uint32_t i, std::uint32_t j) {
+    const int ri = static_cast<int>(i) / nc, ci = static_cast<int>(i) % nc;
+    const int rj = static_cast<int>(j) / nc, cj = static_cast<int>(j) % nc;
+    return std::max(std::abs(ri - rj), std::abs(ci - cj));
+  };
+  for (int r = 0; r < nr; ++r)
+    for (int c = 0; c < nc; ++c) {
+      const std::uint32_t q = static_cast<std::uint32_t>(r * nc + c);
+      const Eigen::Vector2d p = rest(q);
+      for (int i = std::max(0, r - kReach); i <= std::min(nr - 2, r + kReach - 1); ++i)
+        for (int j = std::max(0, c - kReach); j <= std::min(nc - 2, c + kReach - 1); ++j) {
+          const std::size_t cell =
+              static_cast<std::size_t>(i) * static_cast<std::size_t>(nc - 1) + static_cast<std::size_t>(j);
+          for (std::uint32_t k = cellStart[cell]; k < cellStart[cell + 1]; ++k) {
+            const std::uint32_t t = cellTriangles[k];
+            const std::uint32_t* local = triangleLocal_[t].v;
+            if (std::find(local, local + 6, q) != local + 6) continue;
+            const std::uint32_t a = triangles_[3 * t], b = triangles_[3 * t + 1], cc = triangles_[3 * t + 2];
+            const int hops = std::max({king(q, a), king(q, b), king(q, cc)});  // <= kReach + 1 here
+            double& slot = least[static_cast<std::size_t>(hops)];
+            slot = std::min(slot, triangleDistance2d(p, rest(a), rest(b), rest(cc)));
+          }
+        }
+    }
+  flatProof_.particleTriangle.assign(least.size(), std::numeric_limits<float>::infinity());
+  for (std::size_t h = 0; h < least.size(); ++h)
+    if (std::isfinite(least[h])) flatProof_.particleTriangle[h] = static_cast<float>(least[h]);
+  flatProof_.beyond = static_cast<float>(kReach * std::min(dx, dy));
 }
 
 void Fabric::buildTriangleTables() {

@@ -370,7 +370,125 @@ float SelfCollision::predictMotion(const CapeState& state, const Eigen::VectorXf
     mz[i] -= translation.z() + k(2, 0) * rx + k(2, 1) * ry + k(2, 2) * rz;
   }
   stepMotionNorm_ = stepMotion_.rowwise().norm();  // same size every step: no allocation
-  return stepMotionNorm_.maxCoeff();
+  largestMotion_ = stepMotionNorm_.maxCoeff();
+  return largestMotion_;
+}
+
+bool SelfCollision::provenApart(const Points& x) const {
+  // The flat proof. A grid cape is a map x(u) from its rest rectangle D (convex, in the plane) into space,
+  // affine over each triangle t with gradient F_t (3 x 2). For two rest points u, v the segment between them
+  // lies in D, so x(v) - x(u) = integral of F (v - u) along it, a weighted mean of the F_t d |v - u| with
+  // d = (v - u) / |v - u|. Against any fixed F0 and unit n = F0 d / |F0 d|:
+  //   |x(v) - x(u)| >= n . (x(v) - x(u)) >= |v - u| min_t d' S_t d / sqrt(d' G d),
+  // S_t = (F0' F_t + F_t' F0) / 2, G = F0' F0. Where every S_t >= lambda G (lambda > 0, the least
+  // eigenvalue of G^-1/2 S_t G^-1/2), that is at least kappa |v - u|, kappa = lambda sigma_min(F0): a cape
+  // that is stretched and bent by little (F_t near F0) keeps every two of its points at least kappa times
+  // their rest distance apart. A particle and a triangle it is not local to are at least the fabric's
+  // FlatProof::particleTriangle apart at rest, a hinge's opposite edges edgePairRestGap(); a search keeps a
+  // pair only within the thickness, the slack and their relative predicted motion (at most twice the largest
+  // motion) of each other. So where kappa times each rest gap exceeds that reach, the search would find
+  // nothing, and is passed over. F0 is the mean gradient. The walking cape is proven apart this way in most
+  // frames (docs/PERFORMANCE.md); a folding one is not, and is searched as before.
+  const Fabric::FlatProof* proof = fabric_.flatProof();
+  if (proof == nullptr || edgePairRestGap_.empty()) return false;
+  // How much closer two particles h king's moves apart may come over the window: at most h times the most
+  // that two neighbours (a structural or shear spring apart) may, along a path of h neighbours, and at most
+  // twice the largest motion.
+  const int columns = fabric_.gridColumns(), rows = fabric_.gridRows();
+  const float *mx = stepMotion_.col(0).data(), *my = stepMotion_.col(1).data(),
+              *mz = stepMotion_.col(2).data();
+  float neighbour2 = 0.0f;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < columns; ++c) {
+      const int i = r * columns + c;
+      const auto apart2 = [&](int j) {
+        const float dx = mx[i] - mx[j], dy = my[i] - my[j], dz = mz[i] - mz[j];
+        return dx * dx + dy * dy + dz * dz;
+      };
+      if (c + 1 < columns) neighbour2 = std::max(neighbour2, apart2(i + 1));
+      if (r + 1 < rows) {
+        neighbour2 = std::max(neighbour2, apart2(i + columns));
+        if (c + 1 < columns) neighbour2 = std::max(neighbour2, apart2(i + columns + 1));
+        if (c > 0) neighbour2 = std::max(neighbour2, apart2(i + columns - 1));
+      }
+    }
+  const float neighbour = std::sqrt(neighbour2), largest = 2.0f * largestMotion_;
+  const float edgeThickness = kEdgeThicknessFraction * thickness_;
+  // The least kappa that keeps every pair out of reach: each kind of pair's reach over its rest gap.
+  float wanted = (thickness_ + slack_ + largest) / proof->beyond;
+  float closest = proof->beyond;
+  for (std::size_t h = 0; h < proof->particleTriangle.size(); ++h) {
+    const float gap = proof->particleTriangle[h];
+    if (gap == std::numeric_limits<float>::infinity()) continue;
+    if (!(gap > 0.0f)) return false;  // touching at rest: nothing to prove with
+    wanted =
+        std::max(wanted, (thickness_ + slack_ + std::min(largest, static_cast<float>(h) * neighbour)) / gap);
+    closest = std::min(closest, gap);
+  }
+  for (std::size_t h = 0; h < edgePairRestGap_.size(); ++h) {
+    const float gap = edgePairRestGap_[h];
+    if (gap == std::numeric_limits<float>::infinity()) continue;
+    if (!(gap > 0.0f)) return false;  // touching at rest: nothing to prove with
+    wanted = std::max(wanted,
+                      (edgeThickness + slack_ + std::min(largest, static_cast<float>(h) * neighbour)) / gap);
+    closest = std::min(closest, gap);
+  }
+  // Room for rounding: 1 %, and for coordinates far from the origin, whose differences keep fewer digits.
+  const float far = x.cwiseAbs().maxCoeff();
+  wanted = 1.01f * wanted + 64.0f * std::numeric_limits<float>::epsilon() * far / closest;
+  if (!(wanted < 2.0f)) return false;  // not finite, or more than any cape stretched within bounds gives
+  const std::size_t triangles = fabric_.triangleCount();
+  const std::uint32_t* tri = fabric_.triangles().data();
+  const float* inverse = proof->restInverse.data();
+  const float *px = x.col(0).data(), *py = x.col(1).data(), *pz = x.col(2).data();
+  // Triangle t's gradient: its two columns (u, v), [xb - xa, xc - xa] times the rest inverse.
+  const auto gradient = [&](std::size_t t, float* u, float* v) {
+    const std::uint32_t a = tri[3 * t], b = tri[3 * t + 1], c = tri[3 * t + 2];
+    const float* m = inverse + 4 * t;
+    const float e1[3] = {px[b] - px[a], py[b] - py[a], pz[b] - pz[a]};
+    const float e2[3] = {px[c] - px[a], py[c] - py[a], pz[c] - pz[a]};
+    for (int k = 0; k < 3; ++k) {
+      u[k] = e1[k] * m[0] + e2[k] * m[1];
+      v[k] = e1[k] * m[2] + e2[k] * m[3];
+    }
+  };
+  double mean[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  for (std::size_t t = 0; t < triangles; ++t) {
+    float u[3], v[3];
+    gradient(t, u, v);
+    for (int k = 0; k < 3; ++k) {
+      mean[k] += u[k];
+      mean[3 + k] += v[k];
+    }
+  }
+  const Eigen::Vector3d f0u = Eigen::Vector3d(mean[0], mean[1], mean[2]) / static_cast<double>(triangles);
+  const Eigen::Vector3d f0v = Eigen::Vector3d(mean[3], mean[4], mean[5]) / static_cast<double>(triangles);
+  // G and its Cholesky factor L; M = L^-1 = [m11 0; m21 m22], so that M S_t M' has G^-1/2 S_t G^-1/2's
+  // eigenvalues.
+  const double g11 = f0u.squaredNorm(), g12 = f0u.dot(f0v), g22 = f0v.squaredNorm();
+  const double sigma2 = 0.5 * (g11 + g22) - std::sqrt(0.25 * (g11 - g22) * (g11 - g22) + g12 * g12);
+  if (!(sigma2 > 0.0) || !(g11 > 0.0)) return false;
+  const double l11 = std::sqrt(g11), l21 = g12 / l11, l22sq = g22 - l21 * l21;
+  if (!(l22sq > 0.0)) return false;
+  const double l22 = std::sqrt(l22sq);
+  const double m11 = 1.0 / l11, m22 = 1.0 / l22, m21 = -l21 / (l11 * l22);
+  const float lambda = static_cast<float>(static_cast<double>(wanted) / std::sqrt(sigma2));
+  // M S_t M' = [a11 a12; a12 a22], each entry linear in F_t's columns: a = p . u + q . v.
+  const Eigen::Vector3f p11 = (m11 * m11 * f0u).cast<float>();
+  const Eigen::Vector3f p12 = (m11 * m21 * f0u + 0.5 * m11 * m22 * f0v).cast<float>(),
+                        q12 = (0.5 * m11 * m22 * f0u).cast<float>();
+  const Eigen::Vector3f p22 = (m21 * m21 * f0u + m21 * m22 * f0v).cast<float>(),
+                        q22 = (m21 * m22 * f0u + m22 * m22 * f0v).cast<float>();
+  for (std::size_t t = 0; t < triangles; ++t) {
+    float u[3], v[3];
+    gradient(t, u, v);
+    const Eigen::Vector3f fu(u[0], u[1], u[2]), fv(v[0], v[1], v[2]);
+    const float a11 = p11.dot(fu) - lambda, a22 = p22.dot(fu) + q22.dot(fv) - lambda;
+    const float a12 = p12.dot(fu) + q12.dot(fv);
+    // The least eigenvalue of M S_t M' at least lambda: [a11 a12; a12 a22] (lambda taken off) >= 0.
+    if (!(a11 >= 0.0f && a22 >= 0.0f && a11 * a22 >= a12 * a12)) return false;
+  }
+  return true;
 }
 
 CAPE_ALWAYS_INLINE inline bool SelfCollision::particleFull() const {
@@ -455,6 +573,10 @@ void SelfCollision::find(const Points& x, const Points& v, float thickness) {
   x_ = &x;
   thickness_ = thickness;
   slack_ = 0.25f * fabric_.meanSpacing();
+  if (flatProof_ && provenApart(x)) {
+    ++provenApart_;
+    return;
+  }
   invCell_ = 1.0f / (2.0f * fabric_.meanSpacing());
   mask_ = static_cast<std::uint32_t>(hashStart_.size() - 1) - 1;
   // Each particle's swept box: from where it is to where its predicted motion takes it (the same size every
@@ -516,6 +638,47 @@ void SelfCollision::buildEdgePairs() {
       edgePairs_.push_back({b, c, a, d});
     }
   edgeAxis_.assign(3 * edgePairs_.size(), 0.0f);  // none yet: every pair's first search is exact
+  // The flat proof's rest gaps between opposite edges, by how many king's moves their farthest ends are
+  // apart (a grid's rest shape is in the plane z = 0).
+  if (fabric_.flatProof() == nullptr) return;
+  const Points& rest = fabric_.restPositions();
+  const int columns = fabric_.gridColumns();
+  const auto at2 = [&rest](std::uint32_t i) { return Eigen::Vector2d(rest(i, 0), rest(i, 1)); };
+  const auto king = [columns](std::uint32_t i, std::uint32_t j) {
+    const int ri = static_cast<int>(i) / columns, ci = static_cast<int>(i) % columns;
+    const int rj = static_cast<int>(j) / columns, cj = static_cast<int>(j) % columns;
+    return std::max(std::abs(ri - rj), std::abs(ci - cj));
+  };
+  const auto pointToSegment = [](const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                                 const Eigen::Vector2d& b) {
+    const Eigen::Vector2d ab = b - a;
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    return (p - (a + t * ab)).norm();
+  };
+  const auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
+  std::vector<double> least;
+  for (const EdgePair& e : edgePairs_) {
+    const Eigen::Vector2d p0 = at2(e.p0), p1 = at2(e.p1), q0 = at2(e.q0), q1 = at2(e.q1);
+    const std::size_t hops = static_cast<std::size_t>(
+        std::max({king(e.p0, e.q0), king(e.p0, e.q1), king(e.p1, e.q0), king(e.p1, e.q1)}));
+    if (least.size() <= hops) least.resize(hops + 1, std::numeric_limits<double>::infinity());
+    // Segments that cross or touch (or lie on one line) count as 0 apart; otherwise the nearest points
+    // include an end.
+    const double a = cross(p1 - p0, q0 - p0), b = cross(p1 - p0, q1 - p0), c = cross(q1 - q0, p0 - q0),
+                 d = cross(q1 - q0, p1 - q0);
+    const bool crossing = ((a <= 0.0 && b >= 0.0) || (a >= 0.0 && b <= 0.0)) &&
+                          ((c <= 0.0 && d >= 0.0) || (c >= 0.0 && d <= 0.0));
+    const double gap = crossing ? 0.0
+                                : std::min({pointToSegment(p0, q0, q1), pointToSegment(p1, q0, q1),
+                                            pointToSegment(q0, p0, p1), pointToSegment(q1, p0, p1)});
+    least[hops] = std::min(least[hops], gap);
+  }
+  edgePairRestGap_.assign(least.size(), std::numeric_limits<float>::infinity());
+  for (std::size_t h = 0; h < least.size(); ++h)
+    if (std::isfinite(least[h])) edgePairRestGap_[h] = static_cast<float>(least[h]);
 }
 
 void SelfCollision::findEdges(const Points& x) {

@@ -89,6 +89,18 @@ class SelfCollision {
   const std::vector<EdgePair>& edgePairs() const { return edgePairs_; }
   const std::vector<EdgeContact>& edgeContacts() const { return edgeContacts_; }
   std::uint64_t searches() const { return searches_; }
+  /// Searches that the flat proof passed over (provenApart()): no contact was possible, none was looked for.
+  std::uint64_t searchesProvenApart() const { return provenApart_; }
+  /// Whether searches may try the flat proof first (on by default; tests turn it off to compare).
+  void setFlatProof(bool on) { flatProof_ = on; }
+  /// Whether no particle-triangle or edge-edge pair of the cape at x can be within a search's reach: the
+  /// flat proof (see the definition). Reads the thickness, slack and predicted motion of the search that
+  /// find() is running. false where it cannot tell (and for a fabric that is not a grid).
+  bool provenApart(const Points& x) const;
+  /// [h]: the least rest distance between a hinge's opposite edges (edgePairs()) whose farthest ends are h
+  /// king's moves apart on the grid, m (+inf where there is none); empty before allocate() or for a fabric
+  /// that is not a grid.
+  const std::vector<float>& edgePairRestGap() const { return edgePairRestGap_; }
   /// Bytes held by the search's scratch: none until allocate() or the first search.
   std::size_t scratchBytes() const;
   /// Sizes the search's scratch (once; a search does it if nothing has): Cape calls it when self-collision
@@ -125,8 +137,12 @@ class SelfCollision {
   std::vector<EdgePair> edgePairs_;
   std::vector<float> edgeAxis_;  ///< Per edge pair: the unit direction that last separated its edges.
   std::vector<EdgeContact> edgeContacts_;
-  double validUntil_ = -1.0;    ///< s: the contacts cover the motion until this time.
-  std::uint64_t searches_ = 0;  ///< Searches so far (diagnostics).
+  double validUntil_ = -1.0;       ///< s: the contacts cover the motion until this time.
+  std::uint64_t searches_ = 0;     ///< Searches so far (diagnostics).
+  std::uint64_t provenApart_ = 0;  ///< Searches passed over by the flat proof (diagnostics).
+  bool flatProof_ = true;
+  std::vector<float> edgePairRestGap_;  ///< edgePairRestGap().
+  float largestMotion_ = 0.0f;          ///< The largest |stepMotion_|, m (predictMotion).
 
   // The search's scratch, sized once (allocate()).
   std::vector<std::uint32_t> hashStart_;  ///< Spatial hash: bucket offsets (buckets + 1).

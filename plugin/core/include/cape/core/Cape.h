@@ -268,6 +268,10 @@ class CAPE_CORE_API Cape {
   std::size_t selfContactCount() const { return selfContacts().size(); }
   /// Self-contact searches run so far (a search's contacts are kept over the steps its margin covers).
   std::uint64_t selfContactSearches() const;
+  /// Of those, the searches that a proof that the cape lay too flat and too little stretched to come within
+  /// reach of itself passed over (a grid fabric only; the contacts were none, as the search would have
+  /// found).
+  std::uint64_t selfContactSearchesProvenApart() const;
   /// Bytes held by the self-contact search's scratch: none until self-collision is first turned on (at
   /// construction or by setSettings), so a crowd of capes without it does not pay for it.
   std::size_t selfCollisionScratchBytes() const;

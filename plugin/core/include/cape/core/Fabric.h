@@ -228,6 +228,26 @@ class CAPE_CORE_API Fabric {
   /// Per cluster, the particles local to all its triangles.
   const std::vector<ClusterLocalSet>& clusterLocal() const { return clusterLocal_; }
 
+  /// What the self-contact search reads to prove, before it bins anything, that a grid cape lies too flat to
+  /// touch itself (SelfCollision.cpp explains the proof). A grid's rest shape is a rectangle in the plane
+  /// z = 0, which the proof needs: convex, and flat.
+  struct FlatProof {
+    /// Per triangle, the inverse of the 2 x 2 matrix [b - a, c - a] of its rest corners' (x, y), 4 floats
+    /// in column order: the cape's deformation gradient over the triangle is [xb - xa, xc - xa] times it.
+    std::vector<float> restInverse;
+    /// [h]: the least rest distance from a particle to a triangle it is not local to (triangleLocal()) whose
+    /// farthest corner is h king's moves from it on the grid (max(|rows apart|, |columns apart|)), m; +inf
+    /// where there is none. Triangles within kProofReach cells of the particle; every farther triangle is
+    /// at least `beyond` away.
+    std::vector<float> particleTriangle;
+    /// kProofReach times the grid's smaller spacing, m.
+    float beyond = 0.0f;
+  };
+  /// How many cells around a particle FlatProof::particleTriangle looks.
+  static constexpr int kProofReach = 4;
+  /// The flat proof's data of a grid fabric; null for a fabric built by fromMesh().
+  const FlatProof* flatProof() const { return flatProof_.restInverse.empty() ? nullptr : &flatProof_; }
+
   /// The coarse level of a grid fabric, which a cape steps in its place at a coarse level of detail
   /// (Cape::setCoarseLevel): the same size, mass, springs and tether settings over (columns + 1) / 2 x
   /// (rows + 1) / 2 particles (a 20 x 20 grid's is 10 x 10, about a quarter of the work), each tether anchor
@@ -248,12 +268,15 @@ class CAPE_CORE_API Fabric {
   void buildComponents();
   void buildHinges();
   void scheduleHinges();
+  /// flatProof()'s data, for a grid (after buildTriangleTables()).
+  void buildFlatProof();
 
   float meanSpacing_ = 0.0f;
   Eigen::VectorXf particleAreas_;
   std::vector<TriangleLocalSet> triangleLocal_;
   std::vector<std::uint32_t> clusterStart_;
   std::vector<ClusterLocalSet> clusterLocal_;
+  FlatProof flatProof_;
 
   Points restPositions_;
   Eigen::VectorXf masses_;
