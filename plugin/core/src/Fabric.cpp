@@ -218,6 +218,7 @@ FabricResult Fabric::grid(const GridDesc& d) {
   f->gridRows_ = nr;
   f->gridDesc_ = d;
   f->coarse_ = std::make_shared<CoarseCache>();
+  f->flatProof_ = std::make_shared<FlatProofCache>();
   f->restPositions_.resize(n, 3);
   f->uvs_.resize(n);
   for (int r = 0; r < nr; ++r) {
@@ -276,6 +277,17 @@ FabricResult Fabric::grid(const GridDesc& d) {
   result.status = f->finish(d.tetherAnchors, d.tethersPerParticle, d.tetherScale);
   if (result.status.ok()) result.fabric = std::move(f);
   return result;
+}
+
+struct Fabric::FlatProofCache {
+  std::once_flag once;
+  FlatProof proof;
+};
+
+const Fabric::FlatProof* Fabric::flatProof() const {
+  if (!flatProof_ || gridColumns_ < 2 || gridRows_ < 2) return nullptr;
+  std::call_once(flatProof_->once, [this] { buildFlatProof(flatProof_->proof); });
+  return &flatProof_->proof;
 }
 
 struct Fabric::CoarseCache {
@@ -426,7 +438,6 @@ Status Fabric::finish(const std::vector<std::uint32_t>& anchors, int tethersPerP
         structural.size() > 0 ? static_cast<float>(sum / static_cast<double>(structural.size())) : 0.01f;
   }
   buildTriangleTables();
-  if (gridColumns_ > 0) buildFlatProof();
   buildComponents();
   buildHinges();
   return buildTethers(anchors, tethersPerParticle, tetherScale);
@@ -624,7 +635,7 @@ double triangleDistance2d(const Eigen::Vector2d& p, const Eigen::Vector2d& a, co
 
 }  // namespace
 
-void Fabric::buildFlatProof() {
+void Fabric::buildFlatProof(FlatProof& proof) const {
   // Per triangle, the inverse of its rest edge matrix; and the least rest distance from a particle to a
   // triangle not local to it, found among the triangles of the cells around the particle: a triangle of a
   // cell three or more rows or columns away is at least three spacings away, so the search goes no farther
@@ -634,7 +645,7 @@ void Fabric::buildFlatProof() {
   const auto rest = [this](std::uint32_t i) {
     return Eigen::Vector2d(restPositions_(i, 0), restPositions_(i, 1));
   };
-  flatProof_.restInverse.assign(4 * triangles, 0.0f);
+  proof.restInverse.assign(4 * triangles, 0.0f);
   for (std::size_t t = 0; t < triangles; ++t) {
     const Eigen::Vector2d a = rest(triangles_[3 * t]), e1 = rest(triangles_[3 * t + 1]) - a,
                           e2 = rest(triangles_[3 * t + 2]) - a;
@@ -642,7 +653,7 @@ void Fabric::buildFlatProof() {
     m << e1, e2;
     const Eigen::Matrix2d inverse = m.inverse();  // a grid's rest triangles are never degenerate
     for (int k = 0; k < 4; ++k)
-      flatProof_.restInverse[4 * t + static_cast<std::size_t>(k)] = static_cast<float>(inverse(k % 2, k / 2));
+      proof.restInverse[4 * t + static_cast<std::size_t>(k)] = static_cast<float>(inverse(k % 2, k / 2));
   }
   // The triangles of each cell (a triangle's cell: its corners' least row and column).
   const auto cellOf = [nc](std::uint32_t i, std::uint32_t j, std::uint32_t k) {
@@ -663,14 +674,24 @@ void Fabric::buildFlatProof() {
       cellTriangles[cursor[r * static_cast<std::size_t>(nc - 1) + c]++] = static_cast<std::uint32_t>(t);
     }
   }
+  // Each cell's rest rectangle (its triangles' bounding box).
+  std::vector<Eigen::Vector2d> cellLo(cells,
+                                      Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity())),
+      cellHi(cells, Eigen::Vector2d::Constant(-std::numeric_limits<double>::infinity()));
+  for (std::size_t cell = 0; cell < cells; ++cell)
+    for (std::uint32_t k = cellStart[cell]; k < cellStart[cell + 1]; ++k)
+      for (int corner = 0; corner < 3; ++corner) {
+        const Eigen::Vector2d r = rest(triangles_[3 * cellTriangles[k] + static_cast<std::size_t>(corner)]);
+        cellLo[cell] = cellLo[cell].cwiseMin(r);
+        cellHi[cell] = cellHi[cell].cwiseMax(r);
+      }
   constexpr int kReach = kProofReach;
   const double dx = static_cast<double>(gridDesc_.width) / (nc - 1),
                dy = static_cast<double>(gridDesc_.height) / (nr - 1);
   std::vector<double> least(kReach + 3, std::numeric_limits<double>::infinity());
-  const auto king = [nc](std::uint32_t i, std::uint32_t j) {
-    const int ri = static_cast<int>(i) / nc, ci = static_cast<int>(i) % nc;
-    const int rj = static_cast<int>(j) / nc, cj = static_cast<int>(j) % nc;
-    return std::max(std::abs(ri - rj), std::abs(ci - cj));
+  // King's moves between particle q at (r, c) and particle i.
+  const auto king = [nc](int r, int c, std::uint32_t i) {
+    return std::max(std::abs(static_cast<int>(i) / nc - r), std::abs(static_cast<int>(i) % nc - c));
   };
   for (int r = 0; r < nr; ++r)
     for (int c = 0; c < nc; ++c) {
@@ -680,21 +701,26 @@ void Fabric::buildFlatProof() {
         for (int j = std::max(0, c - kReach); j <= std::min(nc - 2, c + kReach - 1); ++j) {
           const std::size_t cell =
               static_cast<std::size_t>(i) * static_cast<std::size_t>(nc - 1) + static_cast<std::size_t>(j);
+          const double gapX = std::max({0.0, cellLo[cell].x() - p.x(), p.x() - cellHi[cell].x()});
+          const double gapY = std::max({0.0, cellLo[cell].y() - p.y(), p.y() - cellHi[cell].y()});
+          const double gap2 = gapX * gapX + gapY * gapY;
           for (std::uint32_t k = cellStart[cell]; k < cellStart[cell + 1]; ++k) {
             const std::uint32_t t = cellTriangles[k];
+            const std::uint32_t a = triangles_[3 * t], b = triangles_[3 * t + 1], cc = triangles_[3 * t + 2];
+            const int hops = std::max({king(r, c, a), king(r, c, b), king(r, c, cc)});  // <= kReach + 1 here
+            double& slot = least[static_cast<std::size_t>(hops)];
+            // Most triangles are farther than the least found already: their cell's rectangle says so.
+            if (gap2 >= slot * slot) continue;
             const std::uint32_t* local = triangleLocal_[t].v;
             if (std::find(local, local + 6, q) != local + 6) continue;
-            const std::uint32_t a = triangles_[3 * t], b = triangles_[3 * t + 1], cc = triangles_[3 * t + 2];
-            const int hops = std::max({king(q, a), king(q, b), king(q, cc)});  // <= kReach + 1 here
-            double& slot = least[static_cast<std::size_t>(hops)];
             slot = std::min(slot, triangleDistance2d(p, rest(a), rest(b), rest(cc)));
           }
         }
     }
-  flatProof_.particleTriangle.assign(least.size(), std::numeric_limits<float>::infinity());
+  proof.particleTriangle.assign(least.size(), std::numeric_limits<float>::infinity());
   for (std::size_t h = 0; h < least.size(); ++h)
-    if (std::isfinite(least[h])) flatProof_.particleTriangle[h] = static_cast<float>(least[h]);
-  flatProof_.beyond = static_cast<float>(kReach * std::min(dx, dy));
+    if (std::isfinite(least[h])) proof.particleTriangle[h] = static_cast<float>(least[h]);
+  proof.beyond = static_cast<float>(kReach * std::min(dx, dy));
 }
 
 void Fabric::buildTriangleTables() {

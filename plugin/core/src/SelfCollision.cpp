@@ -374,7 +374,7 @@ float SelfCollision::predictMotion(const CapeState& state, const Eigen::VectorXf
   return largestMotion_;
 }
 
-bool SelfCollision::provenApart(const Points& x) const {
+bool SelfCollision::provenApart(const Points& x) {
   // The flat proof. A grid cape is a map x(u) from its rest rectangle D (convex, in the plane) into space,
   // affine over each triangle t with gradient F_t (3 x 2). For two rest points u, v the segment between them
   // lies in D, so x(v) - x(u) = integral of F (v - u) along it, a weighted mean of the F_t d |v - u| with
@@ -397,21 +397,41 @@ bool SelfCollision::provenApart(const Points& x) const {
   const int columns = fabric_.gridColumns(), rows = fabric_.gridRows();
   const float *mx = stepMotion_.col(0).data(), *my = stepMotion_.col(1).data(),
               *mz = stepMotion_.col(2).data();
-  float neighbour2 = 0.0f;
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < columns; ++c) {
-      const int i = r * columns + c;
-      const auto apart2 = [&](int j) {
-        const float dx = mx[i] - mx[j], dy = my[i] - my[j], dz = mz[i] - mz[j];
-        return dx * dx + dy * dy + dz * dz;
-      };
-      if (c + 1 < columns) neighbour2 = std::max(neighbour2, apart2(i + 1));
-      if (r + 1 < rows) {
-        neighbour2 = std::max(neighbour2, apart2(i + columns));
-        if (c + 1 < columns) neighbour2 = std::max(neighbour2, apart2(i + columns + 1));
-        if (c > 0) neighbour2 = std::max(neighbour2, apart2(i + columns - 1));
-      }
+  // Row by row, each particle against its right, lower-left, lower and lower-right neighbours: contiguous
+  // runs of the motion's columns.
+  const auto run = [mx, my, mz](int from, int to, int offset) {
+    float most = 0.0f;
+    int i = from;
+#if defined(__SSE2__)
+    // Four at a time (a compiler keeps a float maximum scalar, for its NaN rules).
+    __m128 most4 = _mm_setzero_ps();
+    for (; i + 4 <= to; i += 4) {
+      const __m128 dx = _mm_sub_ps(_mm_loadu_ps(mx + i + offset), _mm_loadu_ps(mx + i));
+      const __m128 dy = _mm_sub_ps(_mm_loadu_ps(my + i + offset), _mm_loadu_ps(my + i));
+      const __m128 dz = _mm_sub_ps(_mm_loadu_ps(mz + i + offset), _mm_loadu_ps(mz + i));
+      most4 = _mm_max_ps(most4,
+                         _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)));
     }
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, most4);
+    most = std::max(std::max(lanes[0], lanes[1]), std::max(lanes[2], lanes[3]));
+#endif
+    for (; i < to; ++i) {
+      const float dx = mx[i + offset] - mx[i], dy = my[i + offset] - my[i], dz = mz[i + offset] - mz[i];
+      const float d2 = dx * dx + dy * dy + dz * dz;
+      most = most < d2 ? d2 : most;
+    }
+    return most;
+  };
+  float neighbour2 = 0.0f;
+  for (int r = 0; r < rows; ++r) {
+    const int start = r * columns;
+    neighbour2 = std::max(neighbour2, run(start, start + columns - 1, 1));
+    if (r + 1 == rows) break;
+    neighbour2 = std::max({neighbour2, run(start, start + columns, columns),
+                           run(start, start + columns - 1, columns + 1),
+                           run(start + 1, start + columns, columns - 1)});
+  }
   const float neighbour = std::sqrt(neighbour2), largest = 2.0f * largestMotion_;
   const float edgeThickness = kEdgeThicknessFraction * thickness_;
   // The least kappa that keeps every pair out of reach: each kind of pair's reach over its rest gap.
@@ -452,17 +472,26 @@ bool SelfCollision::provenApart(const Points& x) const {
       v[k] = e1[k] * m[2] + e2[k] * m[3];
     }
   };
-  double mean[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-  for (std::size_t t = 0; t < triangles; ++t) {
-    float u[3], v[3];
-    gradient(t, u, v);
-    for (int k = 0; k < 3; ++k) {
-      mean[k] += u[k];
-      mean[3 + k] += v[k];
-    }
+  // F0, the mean of the F_t: the triangles have equal rest areas, so it is the integral of the gradient over
+  // the rectangle over its area, which its sides give (x is linear along them): the u column is the mean
+  // of the right side less the left over the width, the v column (rest y, which falls with the row) the top
+  // row less the bottom over the height, each mean by the trapezoid rule.
+  Eigen::Vector3d sideU = Eigen::Vector3d::Zero(), sideV = Eigen::Vector3d::Zero();
+  const auto point = [px, py, pz](int i) {
+    return Eigen::Vector3d(static_cast<double>(px[i]), static_cast<double>(py[i]),
+                           static_cast<double>(pz[i]));
+  };
+  for (int r = 0; r < rows; ++r) {
+    const double w = r == 0 || r == rows - 1 ? 0.5 : 1.0;
+    sideU += w * (point(r * columns + columns - 1) - point(r * columns));
   }
-  const Eigen::Vector3d f0u = Eigen::Vector3d(mean[0], mean[1], mean[2]) / static_cast<double>(triangles);
-  const Eigen::Vector3d f0v = Eigen::Vector3d(mean[3], mean[4], mean[5]) / static_cast<double>(triangles);
+  for (int c = 0; c < columns; ++c) {
+    const double w = c == 0 || c == columns - 1 ? 0.5 : 1.0;
+    sideV += w * (point(c) - point((rows - 1) * columns + c));
+  }
+  const GridDesc& grid = fabric_.gridDesc();
+  const Eigen::Vector3d f0u = sideU / (static_cast<double>(grid.width) * (rows - 1));
+  const Eigen::Vector3d f0v = sideV / (static_cast<double>(grid.height) * (columns - 1));
   // G and its Cholesky factor L; M = L^-1 = [m11 0; m21 m22], so that M S_t M' has G^-1/2 S_t G^-1/2's
   // eigenvalues.
   const double g11 = f0u.squaredNorm(), g12 = f0u.dot(f0v), g22 = f0v.squaredNorm();
@@ -472,6 +501,9 @@ bool SelfCollision::provenApart(const Points& x) const {
   if (!(l22sq > 0.0)) return false;
   const double l22 = std::sqrt(l22sq);
   const double m11 = 1.0 / l11, m22 = 1.0 / l22, m21 = -l21 / (l11 * l22);
+  // The M S_t M' average to the identity (F0 is the mean gradient), so their least eigenvalue is at most 1
+  // somewhere and kappa at most sigma_min(F0): a cape that cannot pass is told so without the second pass.
+  if (!(static_cast<double>(wanted) <= std::sqrt(sigma2))) return false;
   const float lambda = static_cast<float>(static_cast<double>(wanted) / std::sqrt(sigma2));
   // M S_t M' = [a11 a12; a12 a22], each entry linear in F_t's columns: a = p . u + q . v.
   const Eigen::Vector3f p11 = (m11 * m11 * f0u).cast<float>();
@@ -479,14 +511,21 @@ bool SelfCollision::provenApart(const Points& x) const {
                         q12 = (0.5 * m11 * m22 * f0u).cast<float>();
   const Eigen::Vector3f p22 = (m21 * m21 * f0u + m21 * m22 * f0v).cast<float>(),
                         q22 = (m21 * m22 * f0u + m22 * m22 * f0v).cast<float>();
-  for (std::size_t t = 0; t < triangles; ++t) {
+  // From the triangle that failed the last proof: a cape that cannot pass mostly fails where it failed
+  // before (a pinned corner, a fluttering hem), and is then told so at once.
+  const std::size_t first = lastFailed_ < triangles ? lastFailed_ : 0;
+  for (std::size_t k = 0; k < triangles; ++k) {
+    const std::size_t t = first + k < triangles ? first + k : first + k - triangles;
     float u[3], v[3];
     gradient(t, u, v);
     const Eigen::Vector3f fu(u[0], u[1], u[2]), fv(v[0], v[1], v[2]);
     const float a11 = p11.dot(fu) - lambda, a22 = p22.dot(fu) + q22.dot(fv) - lambda;
     const float a12 = p12.dot(fu) + q12.dot(fv);
     // The least eigenvalue of M S_t M' at least lambda: [a11 a12; a12 a22] (lambda taken off) >= 0.
-    if (!(a11 >= 0.0f && a22 >= 0.0f && a11 * a22 >= a12 * a12)) return false;
+    if (!(a11 >= 0.0f && a22 >= 0.0f && a11 * a22 >= a12 * a12)) {
+      lastFailed_ = t;
+      return false;
+    }
   }
   return true;
 }

@@ -96,7 +96,7 @@ class SelfCollision {
   /// Whether no particle-triangle or edge-edge pair of the cape at x can be within a search's reach: the
   /// flat proof (see the definition). Reads the thickness, slack and predicted motion of the search that
   /// find() is running. false where it cannot tell (and for a fabric that is not a grid).
-  bool provenApart(const Points& x) const;
+  bool provenApart(const Points& x);
   /// [h]: the least rest distance between a hinge's opposite edges (edgePairs()) whose farthest ends are h
   /// king's moves apart on the grid, m (+inf where there is none); empty before allocate() or for a fabric
   /// that is not a grid.
@@ -143,6 +143,7 @@ class SelfCollision {
   bool flatProof_ = true;
   std::vector<float> edgePairRestGap_;  ///< edgePairRestGap().
   float largestMotion_ = 0.0f;          ///< The largest |stepMotion_|, m (predictMotion).
+  std::size_t lastFailed_ = 0;  ///< The triangle that failed the last flat proof (where the next starts).
 
   // The search's scratch, sized once (allocate()).
   std::vector<std::uint32_t> hashStart_;  ///< Spatial hash: bucket offsets (buckets + 1).

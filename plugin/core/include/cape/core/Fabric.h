@@ -245,8 +245,10 @@ class CAPE_CORE_API Fabric {
   };
   /// How many cells around a particle FlatProof::particleTriangle looks.
   static constexpr int kProofReach = 4;
-  /// The flat proof's data of a grid fabric; null for a fabric built by fromMesh().
-  const FlatProof* flatProof() const { return flatProof_.restInverse.empty() ? nullptr : &flatProof_; }
+  /// The flat proof's data of a grid fabric; null for a fabric built by fromMesh(). Built on the first call
+  /// (thread-safe; a self-colliding cape's first search, or Cape's turning self-collision on) and shared by
+  /// every cape of this fabric.
+  const FlatProof* flatProof() const;
 
   /// The coarse level of a grid fabric, which a cape steps in its place at a coarse level of detail
   /// (Cape::setCoarseLevel): the same size, mass, springs and tether settings over (columns + 1) / 2 x
@@ -268,15 +270,17 @@ class CAPE_CORE_API Fabric {
   void buildComponents();
   void buildHinges();
   void scheduleHinges();
-  /// flatProof()'s data, for a grid (after buildTriangleTables()).
-  void buildFlatProof();
+  /// flatProof()'s data, for a grid.
+  void buildFlatProof(FlatProof& proof) const;
 
   float meanSpacing_ = 0.0f;
   Eigen::VectorXf particleAreas_;
   std::vector<TriangleLocalSet> triangleLocal_;
   std::vector<std::uint32_t> clusterStart_;
   std::vector<ClusterLocalSet> clusterLocal_;
-  FlatProof flatProof_;
+  /// flatProof()'s data, built once (a pointer, as coarse_).
+  struct FlatProofCache;
+  std::shared_ptr<FlatProofCache> flatProof_;
 
   Points restPositions_;
   Eigen::VectorXf masses_;
