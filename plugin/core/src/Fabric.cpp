@@ -636,10 +636,10 @@ double triangleDistance2d(const Eigen::Vector2d& p, const Eigen::Vector2d& a, co
 }  // namespace
 
 void Fabric::buildFlatProof(FlatProof& proof) const {
-  // Per triangle, the inverse of its rest edge matrix; and the least rest distance from a particle to a
-  // triangle not local to it, found among the triangles of the cells around the particle: a triangle of a
-  // cell three or more rows or columns away is at least three spacings away, so the search goes no farther
-  // and the figure is capped there.
+  // Per triangle, the inverse of its rest edge matrix; and by king's moves, the least rest distance from a
+  // particle to a triangle not local to it, among the triangles of the cells up to kProofReach rows and
+  // columns around the particle (every triangle of at most kProofReach moves is there); the triangle of a
+  // cell farther out is at least kProofReach of the smaller spacings away (`beyond`).
   const int nc = gridColumns_, nr = gridRows_;
   const std::size_t triangles = triangleCount();
   const auto rest = [this](std::uint32_t i) {
@@ -688,7 +688,7 @@ void Fabric::buildFlatProof(FlatProof& proof) const {
   constexpr int kReach = kProofReach;
   const double dx = static_cast<double>(gridDesc_.width) / (nc - 1),
                dy = static_cast<double>(gridDesc_.height) / (nr - 1);
-  std::vector<double> least(kReach + 3, std::numeric_limits<double>::infinity());
+  std::vector<double> least(kReach + 1, std::numeric_limits<double>::infinity());
   // King's moves between particle q at (r, c) and particle i.
   const auto king = [nc](int r, int c, std::uint32_t i) {
     return std::max(std::abs(static_cast<int>(i) / nc - r), std::abs(static_cast<int>(i) % nc - c));
@@ -707,7 +707,8 @@ void Fabric::buildFlatProof(FlatProof& proof) const {
           for (std::uint32_t k = cellStart[cell]; k < cellStart[cell + 1]; ++k) {
             const std::uint32_t t = cellTriangles[k];
             const std::uint32_t a = triangles_[3 * t], b = triangles_[3 * t + 1], cc = triangles_[3 * t + 2];
-            const int hops = std::max({king(r, c, a), king(r, c, b), king(r, c, cc)});  // <= kReach + 1 here
+            const int hops = std::max(
+                {king(r, c, a), king(r, c, b), king(r, c, cc)});  // <= kReach: the cells' rows and columns
             double& slot = least[static_cast<std::size_t>(hops)];
             // Most triangles are farther than the least found already: their cell's rectangle says so.
             if (gap2 >= slot * slot) continue;
