@@ -839,6 +839,35 @@ TEST(SelfCollision, TheFlatProofsRestGapsAreTheLeastOverEveryPair) {
         if (hops <= Fabric::kProofReach)
           tier[static_cast<std::size_t>(hops)] = std::min(tier[static_cast<std::size_t>(hops)], d);
       }
+    // The hinges' tiers against the search's own edge pairs: each pair at least its tier's gap apart at
+    // rest, and every tier the least of some pair's.
+    detail::SelfCollision search(*fabric);
+    search.allocate();
+    std::vector<double> edgeTier(proof->edgeEdge.size(), std::numeric_limits<double>::infinity());
+    for (const detail::SelfCollision::EdgePair& e : search.edgePairs()) {
+      int hops = 0;
+      for (const std::uint32_t i : {e.p0, e.p1})
+        for (const std::uint32_t j : {e.q0, e.q1})
+          hops = std::max({hops, std::abs(static_cast<int>(i / g.columns) - static_cast<int>(j / g.columns)),
+                           std::abs(static_cast<int>(i % g.columns) - static_cast<int>(j % g.columns))});
+      ASSERT_LT(static_cast<std::size_t>(hops), edgeTier.size()) << g.columns << " x " << g.rows;
+      // Sampled: the least distance over 201 points of each edge, within 1/200 of an edge's length above it.
+      double d = std::numeric_limits<double>::infinity();
+      for (int i = 0; i <= 200; ++i)
+        for (int j = 0; j <= 200; ++j)
+          d = std::min(d, (at2(e.p0) + (at2(e.p1) - at2(e.p0)) * (i / 200.0) -
+                           (at2(e.q0) + (at2(e.q1) - at2(e.q0)) * (j / 200.0)))
+                              .norm());
+      const double length = std::max((at2(e.p1) - at2(e.p0)).norm(), (at2(e.q1) - at2(e.q0)).norm());
+      EXPECT_GE(d, proof->edgeEdge[static_cast<std::size_t>(hops)] - 1e-6) << g.columns << " x " << g.rows;
+      edgeTier[static_cast<std::size_t>(hops)] =
+          std::min(edgeTier[static_cast<std::size_t>(hops)], d - length / 200.0);
+    }
+    for (std::size_t h = 0; h < edgeTier.size(); ++h)
+      if (std::isfinite(proof->edgeEdge[h])) {
+        EXPECT_GE(proof->edgeEdge[h], edgeTier[h] - 1e-6)
+            << g.columns << " x " << g.rows << " edge tier " << h;
+      }
     // Tight: the tiers of up to kProofReach moves take in every such pair, and are their least distance.
     for (int h = 0; h <= Fabric::kProofReach; ++h) {
       const auto k = static_cast<std::size_t>(h);

@@ -633,6 +633,22 @@ double triangleDistance2d(const Eigen::Vector2d& p, const Eigen::Vector2d& a, co
   return std::min({segmentDistance2d(p, a, b), segmentDistance2d(p, b, c), segmentDistance2d(p, c, a)});
 }
 
+/// The distance between segments p0-p1 and q0-q1 in the plane: 0 where they cross or touch (or lie on one
+/// line), else the nearest of their ends' distances from the other segment.
+double segmentsDistance2d(const Eigen::Vector2d& p0, const Eigen::Vector2d& p1, const Eigen::Vector2d& q0,
+                          const Eigen::Vector2d& q1) {
+  const auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
+  const double a = cross(p1 - p0, q0 - p0), b = cross(p1 - p0, q1 - p0), c = cross(q1 - q0, p0 - q0),
+               d = cross(q1 - q0, p1 - q0);
+  if (((a <= 0.0 && b >= 0.0) || (a >= 0.0 && b <= 0.0)) &&
+      ((c <= 0.0 && d >= 0.0) || (c >= 0.0 && d <= 0.0)))
+    return 0.0;
+  return std::min({segmentDistance2d(p0, q0, q1), segmentDistance2d(p1, q0, q1),
+                   segmentDistance2d(q0, p0, p1), segmentDistance2d(q1, p0, p1)});
+}
+
 }  // namespace
 
 void Fabric::buildFlatProof(FlatProof& proof) const {
@@ -722,6 +738,31 @@ void Fabric::buildFlatProof(FlatProof& proof) const {
   for (std::size_t h = 0; h < least.size(); ++h)
     if (std::isfinite(least[h])) proof.particleTriangle[h] = static_cast<float>(least[h]);
   proof.beyond = static_cast<float>(kReach * std::min(dx, dy));
+  // Every hinge: triangle (a, b, c) and the far corner d across its edge a b (triangleLocal()), the quad
+  // a-c-b-d and its opposite edges (a c, b d) and (b c, a d), as the search lists them (from both triangles
+  // here: the same pairs).
+  // How many king's moves apart two edges' farthest ends are.
+  const auto moves = [&](std::uint32_t p0, std::uint32_t p1, std::uint32_t q0, std::uint32_t q1) {
+    const auto from = [&](std::uint32_t i, std::uint32_t j) {
+      return king(static_cast<int>(i) / nc, static_cast<int>(i) % nc, j);
+    };
+    return static_cast<std::size_t>(std::max({from(p0, q0), from(p0, q1), from(p1, q0), from(p1, q1)}));
+  };
+  std::vector<double> edges;
+  for (std::size_t t = 0; t < triangles; ++t)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = triangles_[3 * t + k], b = triangles_[3 * t + (k + 1) % 3],
+                          cc = triangles_[3 * t + (k + 2) % 3], d = triangleLocal_[t].v[3 + k];
+      if (d == ~0u || d == a || d == b) continue;
+      const std::size_t hopsAC = moves(a, cc, b, d), hopsBC = moves(b, cc, a, d);
+      const std::size_t hops = std::max(hopsAC, hopsBC);
+      if (edges.size() <= hops) edges.resize(hops + 1, std::numeric_limits<double>::infinity());
+      edges[hopsAC] = std::min(edges[hopsAC], segmentsDistance2d(rest(a), rest(cc), rest(b), rest(d)));
+      edges[hopsBC] = std::min(edges[hopsBC], segmentsDistance2d(rest(b), rest(cc), rest(a), rest(d)));
+    }
+  proof.edgeEdge.assign(edges.size(), std::numeric_limits<float>::infinity());
+  for (std::size_t h = 0; h < edges.size(); ++h)
+    if (std::isfinite(edges[h])) proof.edgeEdge[h] = static_cast<float>(edges[h]);
 }
 
 void Fabric::buildTriangleTables() {

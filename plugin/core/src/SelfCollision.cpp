@@ -384,14 +384,14 @@ bool SelfCollision::provenApart(const Points& x) {
   // eigenvalue of G^-1/2 S_t G^-1/2), that is at least kappa |v - u|, kappa = lambda sigma_min(F0): a cape
   // that is stretched and bent by little (F_t near F0) keeps every two of its points at least kappa times
   // their rest distance apart. A particle and a triangle it is not local to are at least the fabric's
-  // FlatProof::particleTriangle apart at rest, a hinge's opposite edges edgePairRestGap(); a search keeps a
+  // FlatProof::particleTriangle apart at rest, a hinge's opposite edges FlatProof::edgeEdge; a search keeps a
   // pair only within the thickness, the slack and their relative predicted motion (at most twice the largest
   // motion) of each other. So where kappa times each rest gap exceeds that reach, the search would find
   // nothing, and is passed over. F0 is the mean gradient. The 20 x 20 walking cape is proven apart this way
   // in about half its searches (docs/PERFORMANCE.md); a folding or a larger one seldom is, and is searched as
   // before.
   const Fabric::FlatProof* proof = fabric_.flatProof();
-  if (proof == nullptr || edgePairRestGap_.empty()) return false;
+  if (proof == nullptr) return false;
   // How much closer two particles h king's moves apart may come over the window: at most h times the most
   // that two neighbours (a structural or shear spring apart) may, along a path of h neighbours, and at most
   // twice the largest motion.
@@ -446,8 +446,8 @@ bool SelfCollision::provenApart(const Points& x) {
         std::max(wanted, (thickness_ + slack_ + std::min(largest, static_cast<float>(h) * neighbour)) / gap);
     closest = std::min(closest, gap);
   }
-  for (std::size_t h = 0; h < edgePairRestGap_.size(); ++h) {
-    const float gap = edgePairRestGap_[h];
+  for (std::size_t h = 0; h < proof->edgeEdge.size(); ++h) {
+    const float gap = proof->edgeEdge[h];
     if (gap == std::numeric_limits<float>::infinity()) continue;
     if (!(gap > 0.0f)) return false;  // touching at rest: nothing to prove with
     wanted = std::max(wanted,
@@ -678,47 +678,6 @@ void SelfCollision::buildEdgePairs() {
       edgePairs_.push_back({b, c, a, d});
     }
   edgeAxis_.assign(3 * edgePairs_.size(), 0.0f);  // none yet: every pair's first search is exact
-  // The flat proof's rest gaps between opposite edges, by how many king's moves their farthest ends are
-  // apart (a grid's rest shape is in the plane z = 0).
-  if (fabric_.flatProof() == nullptr) return;
-  const Points& rest = fabric_.restPositions();
-  const int columns = fabric_.gridColumns();
-  const auto at2 = [&rest](std::uint32_t i) { return Eigen::Vector2d(rest(i, 0), rest(i, 1)); };
-  const auto king = [columns](std::uint32_t i, std::uint32_t j) {
-    const int ri = static_cast<int>(i) / columns, ci = static_cast<int>(i) % columns;
-    const int rj = static_cast<int>(j) / columns, cj = static_cast<int>(j) % columns;
-    return std::max(std::abs(ri - rj), std::abs(ci - cj));
-  };
-  const auto pointToSegment = [](const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                                 const Eigen::Vector2d& b) {
-    const Eigen::Vector2d ab = b - a;
-    const double len2 = ab.squaredNorm();
-    const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    return (p - (a + t * ab)).norm();
-  };
-  const auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
-    return u.x() * v.y() - u.y() * v.x();
-  };
-  std::vector<double> least;
-  for (const EdgePair& e : edgePairs_) {
-    const Eigen::Vector2d p0 = at2(e.p0), p1 = at2(e.p1), q0 = at2(e.q0), q1 = at2(e.q1);
-    const std::size_t hops = static_cast<std::size_t>(
-        std::max({king(e.p0, e.q0), king(e.p0, e.q1), king(e.p1, e.q0), king(e.p1, e.q1)}));
-    if (least.size() <= hops) least.resize(hops + 1, std::numeric_limits<double>::infinity());
-    // Segments that cross or touch (or lie on one line) count as 0 apart; otherwise the nearest points
-    // include an end.
-    const double a = cross(p1 - p0, q0 - p0), b = cross(p1 - p0, q1 - p0), c = cross(q1 - q0, p0 - q0),
-                 d = cross(q1 - q0, p1 - q0);
-    const bool crossing = ((a <= 0.0 && b >= 0.0) || (a >= 0.0 && b <= 0.0)) &&
-                          ((c <= 0.0 && d >= 0.0) || (c >= 0.0 && d <= 0.0));
-    const double gap = crossing ? 0.0
-                                : std::min({pointToSegment(p0, q0, q1), pointToSegment(p1, q0, q1),
-                                            pointToSegment(q0, p0, p1), pointToSegment(q1, p0, p1)});
-    least[hops] = std::min(least[hops], gap);
-  }
-  edgePairRestGap_.assign(least.size(), std::numeric_limits<float>::infinity());
-  for (std::size_t h = 0; h < least.size(); ++h)
-    if (std::isfinite(least[h])) edgePairRestGap_[h] = static_cast<float>(least[h]);
 }
 
 void SelfCollision::findEdges(const Points& x) {

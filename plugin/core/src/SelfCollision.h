@@ -93,14 +93,6 @@ class SelfCollision {
   std::uint64_t searchesProvenApart() const { return provenApart_; }
   /// Whether searches may try the flat proof first (on by default; tests turn it off to compare).
   void setFlatProof(bool on) { flatProof_ = on; }
-  /// Whether no particle-triangle or edge-edge pair of the cape at x can be within a search's reach: the
-  /// flat proof (see the definition). Reads the thickness, slack and predicted motion of the search that
-  /// find() is running. false where it cannot tell (and for a fabric that is not a grid).
-  bool provenApart(const Points& x);
-  /// [h]: the least rest distance between a hinge's opposite edges (edgePairs()) whose farthest ends are h
-  /// king's moves apart on the grid, m (+inf where there is none); empty before allocate() or for a fabric
-  /// that is not a grid.
-  const std::vector<float>& edgePairRestGap() const { return edgePairRestGap_; }
   /// Bytes held by the search's scratch: none until allocate() or the first search.
   std::size_t scratchBytes() const;
   /// Sizes the search's scratch (once; a search does it if nothing has): Cape calls it when self-collision
@@ -109,6 +101,10 @@ class SelfCollision {
 
  private:
   float predictMotion(const CapeState& state, const Eigen::VectorXf& freeMask, const Vec3& gravity, float dt);
+  /// Whether no particle-triangle or edge-edge pair of the cape at x can be within a search's reach: the
+  /// flat proof (see the definition). Reads the thickness, slack and predicted motion of the search that
+  /// find() is running. false where it cannot tell (and for a fabric that is not a grid).
+  bool provenApart(const Points& x);
   void find(const Points& x, const Points& v, float thickness);
   /// Bins every cluster's grown box into the hash (find's first half).
   void bin();
@@ -141,8 +137,7 @@ class SelfCollision {
   std::uint64_t searches_ = 0;     ///< Searches so far (diagnostics).
   std::uint64_t provenApart_ = 0;  ///< Searches passed over by the flat proof (diagnostics).
   bool flatProof_ = true;
-  std::vector<float> edgePairRestGap_;  ///< edgePairRestGap().
-  float largestMotion_ = 0.0f;          ///< The largest |stepMotion_|, m (predictMotion).
+  float largestMotion_ = 0.0f;  ///< The largest |stepMotion_|, m (predictMotion).
   std::size_t lastFailed_ = 0;  ///< The triangle that failed the last flat proof (where the next starts).
 
   // The search's scratch, sized once (allocate()).

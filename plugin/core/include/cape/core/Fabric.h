@@ -242,6 +242,10 @@ class CAPE_CORE_API Fabric {
     std::vector<float> particleTriangle;
     /// kProofReach times the grid's smaller spacing, m.
     float beyond = 0.0f;
+    /// [h]: the least rest distance between the opposite edges of a hinge (two triangles sharing an edge, a
+    /// quad: the self-contact search's edge pairs) whose farthest ends are h king's moves apart, m; +inf
+    /// where there is none.
+    std::vector<float> edgeEdge;
   };
   /// How many cells around a particle FlatProof::particleTriangle looks.
   static constexpr int kProofReach = 4;
