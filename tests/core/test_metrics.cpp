@@ -10,6 +10,7 @@
 #include "cape/scenes/Scene.h"
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <random>
@@ -509,6 +510,85 @@ TEST(MetricsFast, SelfIntersectionCountIsTheBruteForceCountOnSprintTurnStates) {
     }
   }
   RecordProperty("statesWithSelfIntersections", positive);
+}
+
+// The count's flat proof settles a frame only where the count without it finds nothing: every frame of the
+// canonical scenes, self-collision on and off, counted with the proof and without (the count without it is
+// the brute-force count, above), and a sample of the proven frames against the brute force itself. It
+// settles most of a walk's frames, and none that intersects.
+#ifdef NDEBUG
+constexpr int kProofSizes[] = {20, 32};
+#else
+constexpr int kProofSizes[] = {20};  // the sanitizer build: 20 x 20 only
+#endif
+TEST(MetricsFast, TheFlatProofSettlesOnlyCountsOfNothing) {
+  std::int64_t frames = 0, proven = 0, intersecting = 0, walkFrames = 0, walkProven = 0;
+  for (const SceneKind kind : {SceneKind::Walk, SceneKind::SprintTurn, SceneKind::Wind})
+    for (const bool self : {false, true})
+      for (const int n : kProofSizes) {
+        CapeSettings s;
+        s.selfCollision = self;
+        SimpleScene scene(kind, n, PinLayout::Corners, s);
+        ASSERT_TRUE(scene.status().ok());
+        SelfIntersectionCounter withProof, without;
+        without.setFlatProof(false);
+        const Fabric& fabric = scene.cape().fabric();
+        for (int frame = 1; frame <= 240; ++frame) {
+          scene.advanceFrame();
+          const Points& x = scene.cape().state().positions;
+          const std::int64_t before = withProof.countsProvenApart();
+          const int count = without.count(fabric, x);
+          ASSERT_EQ(withProof.count(fabric, x), count) << n << " x " << n << ", frame " << frame;
+          const bool settled = withProof.countsProvenApart() > before;
+          if (settled && frame % 60 == 0) {
+            EXPECT_EQ(bruteForceCount(fabric, x), 0) << n << " x " << n << ", frame " << frame;
+          }
+          ++frames;
+          proven += settled ? 1 : 0;
+          intersecting += count > 0 ? 1 : 0;
+          if (kind == SceneKind::Walk && n == 20) {
+            ++walkFrames;
+            walkProven += settled ? 1 : 0;
+          }
+        }
+        EXPECT_EQ(without.countsProvenApart(), 0);
+      }
+  std::printf(
+      "count's flat proof: %lld of %lld frames settled (%lld frames intersect); the 20 x 20 walk %lld "
+      "of %lld\n",
+      static_cast<long long>(proven), static_cast<long long>(frames), static_cast<long long>(intersecting),
+      static_cast<long long>(walkFrames), static_cast<long long>(walkProven));
+  EXPECT_GT(intersecting, 0);                  // the sprint-turn without self-collision passes through itself
+  EXPECT_GE(walkProven, 9 * walkFrames / 10);  // a walking cape is flat enough in nearly every frame
+}
+
+// A sheet folded through itself is not settled by the proof, and is counted; the same sheet flat is.
+TEST(MetricsFast, TheFlatProofDoesNotSettleAFoldedSheet) {
+  const FabricPtr f = makeGrid(12, 12);
+  ASSERT_TRUE(f);
+  SelfIntersectionCounter counter;
+  Points x = f->restPositions();
+  EXPECT_EQ(counter.count(*f, x), 0);
+  EXPECT_EQ(counter.countsProvenApart(), 1);
+  // The lower half folded back up through the upper half: a crease, and triangles crossing.
+  Rng rng(11u);
+  x = foldedAndCrumpled(*f, rng, 0.0f);
+  const int brute = bruteForceCount(*f, x);
+  EXPECT_EQ(counter.count(*f, x), brute);
+  EXPECT_EQ(counter.countsProvenApart(), 1);
+  // Not finite: never proven.
+  x = f->restPositions();
+  x(40, 2) = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(counter.count(*f, x), bruteForceCount(*f, x));
+  x(40, 2) = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(counter.count(*f, x), bruteForceCount(*f, x));
+  EXPECT_EQ(counter.countsProvenApart(), 1);
+  // Far from the origin and flat: proven, and nothing to count.
+  x = f->restPositions();
+  x.rowwise() += Eigen::RowVector3f(4e3f, -2e3f, 1e3f);
+  EXPECT_EQ(counter.count(*f, x), 0);
+  EXPECT_EQ(bruteForceCount(*f, x), 0);
+  EXPECT_EQ(counter.countsProvenApart(), 2);
 }
 
 // --- Penetration ---------------------------------------------------------------------------------------

@@ -804,25 +804,49 @@ TEST(SelfCollision, TheFlatProofsRestGapsAreTheLeastOverEveryPair) {
     const auto at2 = [&rest](std::uint32_t i) { return Eigen::Vector2d(rest(i, 0), rest(i, 1)); };
     std::vector<double> tier(proof->particleTriangle.size(), std::numeric_limits<double>::infinity());
     const std::vector<std::uint32_t>& tri = fabric->triangles();
+    // The rest distance from particle q to triangle t: 0 over it, else to the nearest of its sides.
+    const auto distance = [&](std::uint32_t q, std::size_t t) {
+      const Eigen::Vector2d p = at2(q), a = at2(tri[3 * t]), b = at2(tri[3 * t + 1]), c = at2(tri[3 * t + 2]);
+      const Eigen::Vector2d corners[3] = {a, b, c};
+      double d = std::numeric_limits<double>::infinity();
+      bool inside = true;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d& e0 = corners[k];
+        const Eigen::Vector2d& e1 = corners[(k + 1) % 3];
+        const Eigen::Vector2d side = e1 - e0;
+        inside = inside && side.x() * (p - e0).y() - side.y() * (p - e0).x() >= 0.0;  // counter-clockwise
+        const double along = std::clamp((p - e0).dot(side) / side.squaredNorm(), 0.0, 1.0);
+        d = std::min(d, (p - (e0 + along * side)).norm());
+      }
+      return inside ? 0.0 : d;
+    };
+    // The least distance from a particle to a triangle it is not a corner of (the count's gap), and the least
+    // between two triangles that share no corner (two disjoint triangles in the plane are closest at a
+    // corner).
+    double notCorner = std::numeric_limits<double>::infinity(), disjoint = notCorner;
+    for (std::uint32_t q = 0; q < fabric->particleCount(); ++q)
+      for (std::size_t t = 0; t < fabric->triangleCount(); ++t)
+        if (tri[3 * t] != q && tri[3 * t + 1] != q && tri[3 * t + 2] != q)
+          notCorner = std::min(notCorner, distance(q, t));
+    for (std::size_t s = 0; s < fabric->triangleCount(); ++s)
+      for (std::size_t t = s + 1; t < fabric->triangleCount(); ++t) {
+        const std::uint32_t* a = &tri[3 * s];
+        const std::uint32_t* b = &tri[3 * t];
+        if (std::find(a, a + 3, b[0]) != a + 3 || std::find(a, a + 3, b[1]) != a + 3 ||
+            std::find(a, a + 3, b[2]) != a + 3)
+          continue;
+        for (int k = 0; k < 3; ++k) disjoint = std::min({disjoint, distance(a[k], t), distance(b[k], s)});
+      }
+    EXPECT_NEAR(proof->disjointTriangles, notCorner, 1e-6) << g.columns << " x " << g.rows;
+    EXPECT_GT(proof->disjointTriangles, 0.0f) << g.columns << " x " << g.rows;
+    if (std::isfinite(disjoint)) {
+      EXPECT_LE(proof->disjointTriangles, disjoint + 1e-6) << g.columns << " x " << g.rows;
+    }
     for (std::uint32_t q = 0; q < fabric->particleCount(); ++q)
       for (std::size_t t = 0; t < fabric->triangleCount(); ++t) {
         const std::uint32_t* local = fabric->triangleLocal()[t].v;
         if (std::find(local, local + 6, q) != local + 6) continue;
-        // The distance to the triangle: 0 over it, else to the nearest of its sides.
-        const Eigen::Vector2d p = at2(q), a = at2(tri[3 * t]), b = at2(tri[3 * t + 1]),
-                              c = at2(tri[3 * t + 2]);
-        const Eigen::Vector2d corners[3] = {a, b, c};
-        double d = std::numeric_limits<double>::infinity();
-        bool inside = true;
-        for (int k = 0; k < 3; ++k) {
-          const Eigen::Vector2d& e0 = corners[k];
-          const Eigen::Vector2d& e1 = corners[(k + 1) % 3];
-          const Eigen::Vector2d side = e1 - e0;
-          inside = inside && side.x() * (p - e0).y() - side.y() * (p - e0).x() >= 0.0;  // counter-clockwise
-          const double along = std::clamp((p - e0).dot(side) / side.squaredNorm(), 0.0, 1.0);
-          d = std::min(d, (p - (e0 + along * side)).norm());
-        }
-        if (inside) d = 0.0;
+        const double d = distance(q, t);
         int hops = 0;
         for (int k = 0; k < 3; ++k) {
           const int v = static_cast<int>(tri[3 * t + static_cast<std::size_t>(k)]);

@@ -290,6 +290,94 @@ const Fabric::FlatProof* Fabric::flatProof() const {
   return &flatProof_->proof;
 }
 
+bool Fabric::keepsApart(const Points& x, float kappa, std::size_t& startTriangle) const {
+  // The flat proof. A grid cape is a map x(u) from its rest rectangle D (convex, in the plane) into space,
+  // affine over each triangle t with gradient F_t (3 x 2). For two rest points u, v the segment between them
+  // lies in D, so x(v) - x(u) = integral of F (v - u) along it, a weighted mean of the F_t d |v - u| with
+  // d = (v - u) / |v - u|. Against any fixed F0 and unit n = F0 d / |F0 d|:
+  //   |x(v) - x(u)| >= n . (x(v) - x(u)) >= |v - u| min_t d' S_t d / sqrt(d' G d),
+  // S_t = (F0' F_t + F_t' F0) / 2, G = F0' F0. Where every S_t >= lambda G (lambda > 0, the least
+  // eigenvalue of G^-1/2 S_t G^-1/2), that is at least kappa |v - u|, kappa = lambda sigma_min(F0): a cape
+  // that is stretched and bent by little (F_t near F0) keeps every two of its points at least kappa times
+  // their rest distance apart. F0 is the mean gradient.
+  const FlatProof* proof = flatProof();
+  if (proof == nullptr || !(kappa > 0.0f) || x.rows() != static_cast<Eigen::Index>(particleCount()))
+    return false;
+  const std::size_t triangles = triangleCount();
+  const std::uint32_t* tri = triangles_.data();
+  const int columns = gridColumns_, rows = gridRows_;
+  const float* inverse = proof->restInverse.data();
+  const float *px = x.col(0).data(), *py = x.col(1).data(), *pz = x.col(2).data();
+  // Triangle t's gradient: its two columns (u, v), [xb - xa, xc - xa] times the rest inverse.
+  const auto gradient = [&](std::size_t t, float* u, float* v) {
+    const std::uint32_t a = tri[3 * t], b = tri[3 * t + 1], c = tri[3 * t + 2];
+    const float* m = inverse + 4 * t;
+    const float e1[3] = {px[b] - px[a], py[b] - py[a], pz[b] - pz[a]};
+    const float e2[3] = {px[c] - px[a], py[c] - py[a], pz[c] - pz[a]};
+    for (int k = 0; k < 3; ++k) {
+      u[k] = e1[k] * m[0] + e2[k] * m[1];
+      v[k] = e1[k] * m[2] + e2[k] * m[3];
+    }
+  };
+  // F0, the mean of the F_t: the triangles have equal rest areas, so it is the integral of the gradient over
+  // the rectangle over its area, which its sides give (x is linear along them): the u column is the mean
+  // of the right side less the left over the width, the v column (rest y, which falls with the row) the top
+  // row less the bottom over the height, each mean by the trapezoid rule.
+  Eigen::Vector3d sideU = Eigen::Vector3d::Zero(), sideV = Eigen::Vector3d::Zero();
+  const auto point = [px, py, pz](int i) {
+    return Eigen::Vector3d(static_cast<double>(px[i]), static_cast<double>(py[i]),
+                           static_cast<double>(pz[i]));
+  };
+  for (int r = 0; r < rows; ++r) {
+    const double w = r == 0 || r == rows - 1 ? 0.5 : 1.0;
+    sideU += w * (point(r * columns + columns - 1) - point(r * columns));
+  }
+  for (int c = 0; c < columns; ++c) {
+    const double w = c == 0 || c == columns - 1 ? 0.5 : 1.0;
+    sideV += w * (point(c) - point((rows - 1) * columns + c));
+  }
+  const GridDesc& grid = gridDesc_;
+  const Eigen::Vector3d f0u = sideU / (static_cast<double>(grid.width) * (rows - 1));
+  const Eigen::Vector3d f0v = sideV / (static_cast<double>(grid.height) * (columns - 1));
+  // G and its Cholesky factor L; M = L^-1 = [m11 0; m21 m22], so that M S_t M' has G^-1/2 S_t G^-1/2's
+  // eigenvalues.
+  const double g11 = f0u.squaredNorm(), g12 = f0u.dot(f0v), g22 = f0v.squaredNorm();
+  const double sigma2 = 0.5 * (g11 + g22) - std::sqrt(0.25 * (g11 - g22) * (g11 - g22) + g12 * g12);
+  if (!(sigma2 > 0.0) || !(g11 > 0.0)) return false;
+  const double l11 = std::sqrt(g11), l21 = g12 / l11, l22sq = g22 - l21 * l21;
+  if (!(l22sq > 0.0)) return false;
+  const double l22 = std::sqrt(l22sq);
+  const double m11 = 1.0 / l11, m22 = 1.0 / l22, m21 = -l21 / (l11 * l22);
+  // The M S_t M' average to the identity (F0 is the mean gradient), so their least eigenvalue is at most 1
+  // somewhere and kappa at most sigma_min(F0): a cape that cannot pass is told so without the second pass.
+  if (!(static_cast<double>(kappa) <= std::sqrt(sigma2))) return false;
+  const float lambda = static_cast<float>(static_cast<double>(kappa) / std::sqrt(sigma2));
+  // M S_t M' = [a11 a12; a12 a22], each entry linear in F_t's columns: a = p . u + q . v.
+  const Eigen::Vector3f p11 = (m11 * m11 * f0u).cast<float>();
+  const Eigen::Vector3f p12 = (m11 * m21 * f0u + 0.5 * m11 * m22 * f0v).cast<float>(),
+                        q12 = (0.5 * m11 * m22 * f0u).cast<float>();
+  const Eigen::Vector3f p22 = (m21 * m21 * f0u + m21 * m22 * f0v).cast<float>(),
+                        q22 = (m21 * m22 * f0u + m22 * m22 * f0v).cast<float>();
+  // From the triangle that failed the last proof: a cape that cannot pass mostly fails where it failed
+  // before (a pinned corner, a fluttering hem), and is then told so at once.
+  const std::size_t first = startTriangle < triangles ? startTriangle : 0;
+  for (std::size_t k = 0; k < triangles; ++k) {
+    const std::size_t t = first + k < triangles ? first + k : first + k - triangles;
+    float u[3], v[3];
+    gradient(t, u, v);
+    const Eigen::Vector3f fu(u[0], u[1], u[2]), fv(v[0], v[1], v[2]);
+    const float a11 = p11.dot(fu) - lambda, a22 = p22.dot(fu) + q22.dot(fv) - lambda;
+    const float a12 = p12.dot(fu) + q12.dot(fv);
+    // The least eigenvalue of M S_t M' at least lambda: [a11 a12; a12 a22] (lambda taken off) >= 0.
+    // (As a difference, so that products too large for a float fail rather than compare inf with inf.)
+    if (!(a11 >= 0.0f && a22 >= 0.0f && a11 * a22 - a12 * a12 >= 0.0f)) {
+      startTriangle = t;
+      return false;
+    }
+  }
+  return true;
+}
+
 struct Fabric::CoarseCache {
   std::once_flag once;
   FabricPtr fabric;
@@ -738,6 +826,26 @@ void Fabric::buildFlatProof(FlatProof& proof) const {
   for (std::size_t h = 0; h < least.size(); ++h)
     if (std::isfinite(least[h])) proof.particleTriangle[h] = static_cast<float>(least[h]);
   proof.beyond = static_cast<float>(kReach * std::min(dx, dy));
+  // Two triangles that share no corner: the least distance from a particle to a triangle of a cell it is a
+  // corner of, not being one of the triangle's; the cells it is not a corner of are at least the smaller
+  // spacing away.
+  double disjoint = std::min(dx, dy);
+  for (int r = 0; r < nr; ++r)
+    for (int c = 0; c < nc; ++c) {
+      const std::uint32_t q = static_cast<std::uint32_t>(r * nc + c);
+      for (int i = std::max(0, r - 1); i <= std::min(nr - 2, r); ++i)
+        for (int j = std::max(0, c - 1); j <= std::min(nc - 2, c); ++j) {
+          const std::size_t cell =
+              static_cast<std::size_t>(i) * static_cast<std::size_t>(nc - 1) + static_cast<std::size_t>(j);
+          for (std::uint32_t k = cellStart[cell]; k < cellStart[cell + 1]; ++k) {
+            const std::uint32_t* corner = &triangles_[3 * static_cast<std::size_t>(cellTriangles[k])];
+            if (corner[0] == q || corner[1] == q || corner[2] == q) continue;
+            disjoint = std::min(
+                disjoint, triangleDistance2d(rest(q), rest(corner[0]), rest(corner[1]), rest(corner[2])));
+          }
+        }
+    }
+  proof.disjointTriangles = static_cast<float>(disjoint);
   // Every hinge: triangle (a, b, c) and the far corner d across its edge a b (triangleLocal()), the quad
   // a-c-b-d and its opposite edges (a c, b d) and (b c, a d), as the search lists them (from both triangles
   // here: the same pairs).

@@ -246,6 +246,9 @@ class CAPE_CORE_API Fabric {
     /// quad: the self-contact search's edge pairs) whose farthest ends are h king's moves apart, m; +inf
     /// where there is none.
     std::vector<float> edgeEdge;
+    /// The least rest distance between two triangles that share no corner, m: the least from a particle to
+    /// a triangle it is not a corner of (two disjoint triangles in the plane are closest at a corner of one).
+    float disjointTriangles = 0.0f;
   };
   /// How many cells around a particle FlatProof::particleTriangle looks.
   static constexpr int kProofReach = 4;
@@ -253,6 +256,12 @@ class CAPE_CORE_API Fabric {
   /// (thread-safe; a self-colliding cape's first search, or Cape's turning self-collision on) and shared by
   /// every cape of this fabric.
   const FlatProof* flatProof() const;
+  /// The flat proof's bound: true when `positions` (one row per particle) provably keep every two points of
+  /// this grid cape's surface at least `kappa` times their rest distance apart (kappa > 0; the proof is in
+  /// SelfCollision.cpp's provenApart), false when the proof cannot say so (folded, crumpled or inverted
+  /// somewhere, not finite, or a fabric built by fromMesh()). `startTriangle` is where to start the check
+  /// and, on false, becomes the triangle that failed it (a cape that fails mostly fails there again).
+  bool keepsApart(const Points& positions, float kappa, std::size_t& startTriangle) const;
 
   /// The coarse level of a grid fabric, which a cape steps in its place at a coarse level of detail
   /// (Cape::setCoarseLevel): the same size, mass, springs and tether settings over (columns + 1) / 2 x
