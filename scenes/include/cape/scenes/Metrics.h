@@ -58,7 +58,8 @@ CAPE_SCENES_API bool trianglesIntersect(const Vec3& p0, const Vec3& p1, const Ve
 /// on the canonical cape), so none meets another and the count is 0 without a box. That is the geometric
 /// truth of the float positions; the interval test in double agrees with it wherever its rounding (about
 /// 1e-16 of the coordinates, divided by the sine of the angle between two triangles' planes) is under that
-/// distance, which the tests check against the brute-force count on every frame of the canonical scenes.
+/// distance, which the tests check on every frame of the canonical scenes against the count without the proof
+/// (itself tested against the brute-force count), and on a sample of them against the brute force.
 class CAPE_SCENES_API SelfIntersectionCounter {
  public:
   /// The least stretch (kappa) the count's flat proof asks for: a hundredth.
