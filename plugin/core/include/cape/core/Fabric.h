@@ -257,8 +257,8 @@ class CAPE_CORE_API Fabric {
   /// every cape of this fabric.
   const FlatProof* flatProof() const;
   /// The flat proof's bound: true when `positions` (one row per particle) provably keep every two points of
-  /// this grid cape's surface at least `kappa` times their rest distance apart (kappa > 0; the proof is in
-  /// SelfCollision.cpp's provenApart), false when the proof cannot say so (folded, crumpled or inverted
+  /// this grid cape's surface at least `kappa` times their rest distance apart (kappa > 0; the proof is
+  /// written out in Fabric.cpp), false when the proof cannot say so (folded, crumpled or inverted
   /// somewhere, not finite, or a fabric built by fromMesh()). `startTriangle` is where to start the check
   /// and, on false, becomes the triangle that failed it (a cape that fails mostly fails there again).
   bool keepsApart(const Points& positions, float kappa, std::size_t& startTriangle) const;
