@@ -333,7 +333,8 @@ void bindHandles(py::module_& m) {
           "count_self_intersections",
           [](const CapeHandle& c) { return c.world->countSelfIntersections(c.index); },
           [](const CapeHandle& c, bool on) { c.world->setCountSelfIntersections(c.index, on); },
-          "Count intersecting triangle pairs in the per-frame metrics (off by default: it costs).")
+          "Count intersecting triangle pairs in the per-frame metrics (off by default: a pass over the "
+          "triangles for a grid cape that lies flat, a spatial hash and exact tests for one that folds).")
       .def_property_readonly(
           "positions", [](const CapeHandle& c) { return pointsToArray(c.world->capePositions(c.index)); },
           "(N, 3) float32, m, world.")

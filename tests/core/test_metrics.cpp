@@ -589,6 +589,17 @@ TEST(MetricsFast, TheFlatProofDoesNotSettleAFoldedSheet) {
   EXPECT_EQ(counter.count(*f, x), 0);
   EXPECT_EQ(bruteForceCount(*f, x), 0);
   EXPECT_EQ(counter.countsProvenApart(), 2);
+  // Flat, turned and stretched 1e30 times: the proof's products stay within a float's range, and it settles.
+  const Eigen::Matrix3f turn = randomRotation(rng).toRotationMatrix();
+  x = (f->restPositions() * 1e30f) * turn.transpose();
+  EXPECT_EQ(counter.count(*f, x), 0);
+  EXPECT_EQ(bruteForceCount(*f, x), 0);
+  EXPECT_EQ(counter.countsProvenApart(), 3);
+  // Shrunk 1e30 times: its points are not a hundredth of their rest distance apart, so the proof cannot
+  // settle it (it bounds distances against the rest shape's), and the count does.
+  x = (f->restPositions() * 1e-30f) * turn.transpose();
+  EXPECT_EQ(counter.count(*f, x), bruteForceCount(*f, x));
+  EXPECT_EQ(counter.countsProvenApart(), 3);
 }
 
 // --- Penetration ---------------------------------------------------------------------------------------
