@@ -557,7 +557,7 @@ TEST(MetricsFast, TheFlatProofSettlesOnlyCountsOfNothing) {
       "count's flat proof: %lld of %lld frames settled (%lld frames intersect); the 20 x 20 walk %lld "
       "of %lld\n",
       static_cast<long long>(proven), static_cast<long long>(frames), static_cast<long long>(intersecting),
-      static_cast<long long>(walkFrames), static_cast<long long>(walkProven));
+      static_cast<long long>(walkProven), static_cast<long long>(walkFrames));
   EXPECT_GT(intersecting, 0);                  // the sprint-turn without self-collision passes through itself
   EXPECT_GE(walkProven, 9 * walkFrames / 10);  // a walking cape is flat enough in nearly every frame
 }
